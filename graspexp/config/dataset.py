@@ -1,0 +1,21 @@
+"""Schema of the ``dataset`` config group."""
+
+from dataclasses import dataclass, field
+
+from omegaconf import MISSING
+
+
+@dataclass
+class DatasetConfig:
+    """Which object set to load and from where."""
+
+    name: str = MISSING
+    """Loader key: ``ycb``, ``linemod`` or ``primitives``."""
+    root: str | None = None
+    """Data root folder. None: env ``GRASPEXP_DATA``, else ``datasets/`` in the working directory."""
+    objects: list[str] = field(default_factory=list)
+    """The dataset's object list (paper Table 1 / Table 2 order); ``objects=[...]`` at top level subsets it."""
+    density_kg_m3: float = 700.0
+    """Density used for the mass when the dataset publishes none (LINEMOD, primitives), kg/m^3."""
+    regions: str = MISSING
+    """Grasping-area spec file name under ``graspexp/datasets/regions/``."""

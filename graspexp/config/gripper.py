@@ -1,0 +1,31 @@
+"""Schema of the ``gripper`` config group: a parallel-jaw gripper, all lengths in metres.
+
+Gripper frame (paper Fig. 9): +Z approach, +Y closing axis, origin midway between the finger pads.
+"""
+
+from dataclasses import dataclass
+
+from omegaconf import MISSING
+
+
+@dataclass
+class GripperConfig:
+    name: str = MISSING
+    max_width_m: float = MISSING
+    """Largest opening between the finger pads (stroke), m."""
+    min_width_m: float = 0.0
+    """Smallest opening between the finger pads, m."""
+    grip_force_n: float = MISSING
+    """Force each finger presses with when closed on an object, N."""
+    finger_length_m: float = 0.05
+    """Finger length along the approach axis (+Z), m."""
+    finger_width_m: float = 0.02
+    """Finger width along the main axis (+X), m."""
+    finger_thickness_m: float = 0.01
+    """Finger thickness along the closing axis (+Y), m."""
+    palm_size_m: list[float] = MISSING
+    """Palm box full size [x, y, z] in the gripper frame, m; its front face touches the finger roots."""
+    pad_friction: float = 1.0
+    """Coulomb friction of the finger pads (PhysX averages with the object's)."""
+    finger_mass_kg: float = 0.05
+    """Mass of each finger, kg."""

@@ -1,0 +1,49 @@
+"""Schema of the top-level job config that composes every group."""
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from omegaconf import MISSING
+
+from graspexp.config.dataset import DatasetConfig
+from graspexp.config.gripper import GripperConfig
+from graspexp.config.mode import ModeConfig
+from graspexp.config.planner import CostConfig, PlannerConfig
+from graspexp.config.rot import RotConfig
+from graspexp.config.sim import SimConfig
+
+
+@dataclass
+class PoseNoiseConfig:
+    trans_mm: float = 0.0
+    """Std-dev of the Gaussian translation error added to the pose the planner sees, mm."""
+    rot_deg: float = 0.0
+    """Std-dev of the rotation-angle error (random axis) added to that pose, degrees."""
+
+
+@dataclass
+class PerceptionConfig:
+    noise: PoseNoiseConfig = field(default_factory=PoseNoiseConfig)
+
+
+@dataclass
+class JobConfig:
+    defaults: list[Any] = field(default_factory=list)
+    dataset: DatasetConfig = MISSING
+    mode: ModeConfig = MISSING
+    rot: RotConfig = MISSING
+    gripper: GripperConfig = MISSING
+    planner: PlannerConfig = MISSING
+    cost: CostConfig = MISSING
+    sim: SimConfig = MISSING
+    perception: PerceptionConfig = field(default_factory=PerceptionConfig)
+    trials: int = 10
+    """Trials per object."""
+    seed: int = 0
+    """Global seed; each trial's seed derives from (seed, object, trial index)."""
+    objects: list[str] | None = None
+    """Subset of the dataset's objects; None: all of them."""
+    record: bool = True
+    """Write one MCAP log per trial."""
+    progress: bool = True
+    """Show a progress bar."""

@@ -1,0 +1,25 @@
+"""Schema of the ``mode`` config group: collaborative hand-over or bin picking (paper IV-A, IV-C)."""
+
+from dataclasses import dataclass
+
+from omegaconf import MISSING
+
+
+@dataclass
+class ModeConfig:
+    name: str = MISSING
+    """``collab`` (Eq. 1; box removed after the grasp) or ``bin`` (Eq. 2-3; table, pull back)."""
+    support_height_m: float = 0.10
+    """Height of the support's top face above the ground plane, m (the plane z = h)."""
+    support_half_size_m: list[float] = MISSING
+    """Half extents [x, y] of the support top, m."""
+    support_collides_with_gripper: bool = MISSING
+    """False in collab mode (paper IV-A: the box is not used for gripper collisions)."""
+    remove_support_after_grasp: bool = MISSING
+    """True in collab mode: the box vanishes after the fingers close."""
+    pull_back_m: float = 0.0
+    """Bin mode: distance to retract along the approach direction after closing, m."""
+    lift_m: float = 0.0
+    """Bin mode: extra lift along world +Z after the pull back, m."""
+    hold_s: float = 2.0
+    """Time the grasp must hold at the end, s."""

@@ -1,0 +1,60 @@
+"""Schemas of the ``planner`` and ``cost`` config groups (paper section III).
+
+The cost constants are only meaningful with distances in millimetres and alpha in degrees
+(beta in radians), exactly as printed in the paper's Eq. (1)-(3).
+"""
+
+from dataclasses import dataclass
+from typing import Any
+
+from omegaconf import MISSING
+
+
+@dataclass
+class PlannerConfig:
+    name: str = MISSING
+    """Planner registry key (``optimal`` is the paper's)."""
+    k: Any = "auto"
+    """Number of K-means clusters: ``auto`` (rule in docs/planner) or a positive int."""
+    k_max: int = 8
+    """Upper bound on K when ``k: auto``."""
+    m: int = 256
+    """Grasping paths (Fibonacci sphere points) per cluster."""
+    sphere_radius_m: float = 0.10
+    """Radius of the Fibonacci sphere around each centre = pre-grasp standoff, m."""
+    n_points: int = 2048
+    """Size N of the object's surface point cloud."""
+    width_margin: float = 0.2
+    """Opening = 2 r_k (1 + margin), clipped to the gripper stroke."""
+    table_clearance_m: float = 0.0
+    """A path is dropped when its sphere point lies below the support plane plus this, m."""
+    seed: int = 0
+    """Seed of the K-means initialisation (combined with the trial seed)."""
+
+
+@dataclass
+class CostConfig:
+    """Every constant of Eq. (1)-(3); defaults are the paper's values."""
+
+    angle_weight: float = 0.1
+    """0.1 in (0.1 |alpha_p - 90| + 0.5) / 8, per degree."""
+    angle_target_deg: float = 90.0
+    """90 in |alpha_p - 90|, degrees."""
+    angle_offset: float = 0.5
+    """0.5 in (0.1 |alpha_p - 90| + 0.5) / 8."""
+    angle_divisor: float = 8.0
+    """8 in (0.1 |alpha_p - 90| + 0.5) / 8."""
+    distance_numerator_mm2: float = 20.0
+    """20 in min(1, 20 / ((Y_ip - r_k)^2 + 1)), mm^2."""
+    distance_offset_mm2: float = 1.0
+    """1 in min(1, 20 / ((Y_ip - r_k)^2 + 1)), mm^2."""
+    distance_cap: float = 1.0
+    """1 in min(1, ...)."""
+    table_beta_target_rad: float = 1.5707963267948966
+    """pi/2 in (beta_p - pi/2)^2 / 2 + 0.05, radians."""
+    table_beta_divisor: float = 2.0
+    """2 in (beta_p - pi/2)^2 / 2 + 0.05."""
+    table_offset: float = 0.05
+    """0.05 in (beta_p - pi/2)^2 / 2 + 0.05."""
+    table_far: float = 1.0
+    """T when d_k > g."""

@@ -1,0 +1,13 @@
+"""Schema of the ``rot`` config group: how the object is rotated before it is dropped (paper IV-D)."""
+
+from dataclasses import dataclass
+
+from omegaconf import MISSING
+
+
+@dataclass
+class RotConfig:
+    name: str = MISSING
+    """``z``: upright model pose turned about world Z; ``xyz``: uniformly random rotation."""
+    drop_height_m: float = 0.02
+    """Gap between the object's lowest point and the support top at release, m."""

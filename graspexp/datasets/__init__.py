@@ -1,0 +1,1 @@
+"""Object catalogues and loaders."""

@@ -1,0 +1,35 @@
+"""The object model every later stage consumes."""
+
+from dataclasses import dataclass
+
+import numpy as np
+import trimesh
+
+
+@dataclass(frozen=True)
+class ObjectModel:
+    """One object, in its own frame, metres.
+
+    mesh : trimesh.Trimesh, object frame, metres (vertices merged by position).
+    points : (N, 3) float64, surface samples in the object frame, metres (seeded).
+    normals : (N, 3) float64, outward unit normals of ``points``.
+    area_mask : (N,) bool, True where the point lies in the grasping area.
+    mass_kg : mass, kg.
+    name : catalogue name, e.g. ``025_mug`` or ``ape``.
+    dataset : ``ycb``, ``linemod`` or ``primitives``.
+    source : file the mesh came from ("" for procedural meshes).
+    """
+
+    name: str
+    dataset: str
+    mesh: trimesh.Trimesh
+    points: np.ndarray
+    normals: np.ndarray
+    area_mask: np.ndarray
+    mass_kg: float
+    source: str = ""
+
+    @property
+    def area_points(self) -> np.ndarray:
+        """(n_area, 3) grasping-area points, object frame, metres."""
+        return self.points[self.area_mask]

@@ -1,0 +1,41 @@
+"""What every planner receives; the planner contract is pure: request in, ``PlanResult`` out."""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from graspexp.config import CostConfig, GripperConfig, PlannerConfig
+from graspexp.planning.grasp import Grasp
+
+
+@dataclass(frozen=True)
+class PlanRequest:
+    """Inputs of one planning call, all in the world frame, metres.
+
+    points : (N, 3) object surface cloud transformed by the (perceived) object pose.
+    normals : (N, 3) outward unit normals of ``points``.
+    area_mask : (N,) bool, grasping area.
+    object_pose : (4,4) perceived world pose of the object frame.
+    table_z : height of the support plane z = h, m.
+    mode : ``collab`` (Eq. 1) or ``bin`` (Eq. 2-3).
+    seed : seed for anything random in the planner.
+    """
+
+    points: np.ndarray
+    normals: np.ndarray
+    area_mask: np.ndarray
+    object_pose: np.ndarray
+    table_z: float
+    mode: str
+    gripper: GripperConfig
+    planner: PlannerConfig
+    cost: CostConfig
+    seed: int
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """A grasp plus every intermediate a figure or test may want (keys as in ``+dump=FILE.npz``)."""
+
+    grasp: Grasp
+    details: dict[str, np.ndarray] = field(default_factory=dict)
