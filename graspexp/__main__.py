@@ -3,6 +3,7 @@
 import hydra
 from omegaconf import DictConfig
 
+from graspexp.cli import fail, run_checked
 from graspexp.config import register_configs
 
 register_configs()
@@ -10,14 +11,18 @@ register_configs()
 
 @hydra.main(version_base="1.3", config_path="../conf", config_name="config")
 def _job(cfg: DictConfig) -> float:
+    from graspexp.datasets import DatasetError
     from graspexp.runner import run_job
 
-    return run_job(cfg)
+    try:
+        return run_job(cfg)
+    except DatasetError as exc:
+        fail(str(exc))
 
 
 def main() -> None:
     """Console-script entry (``graspexp``)."""
-    _job()
+    run_checked(_job)
 
 
 if __name__ == "__main__":

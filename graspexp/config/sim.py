@@ -16,6 +16,8 @@ class SimConfig:
     object_static_friction: float = 0.6
     object_dynamic_friction: float = 0.5
     support_friction: float = 0.6
+    object_angular_damping: float = 0.5
+    """Angular velocity damping of the object, 1/s: stands in for rolling resistance (PhysX has none)."""
     settle_max_s: float = 3.0
     """Time cap for the drop to come to rest, s."""
     settle_min_s: float = 0.3

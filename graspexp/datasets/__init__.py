@@ -1,1 +1,31 @@
-"""Object catalogues and loaders."""
+"""Object catalogues and loaders: YCB (google_16k / YCB-Video layouts), BOP LINEMOD and primitives.
+
+Public API (the simulator and planner import these names)::
+
+    load_object(cfg, name, n_points, seed) -> ObjectModel
+    resolve_root(cfg) -> pathlib.Path
+    dataset_objects(cfg) -> list[str]
+    available_objects(cfg) -> list[str]
+    import_meshlab_area(ply_path, object_points, *, scale=1.0, tolerance_m=None) -> (N,) bool
+    DatasetError (a ValueError)
+
+``cfg`` is a :class:`graspexp.config.DatasetConfig` or its composed DictConfig (``dataset``).
+"""
+
+from graspexp.datasets import primitives
+from graspexp.datasets.catalog import available_objects, dataset_objects, resolve_root
+from graspexp.datasets.errors import DatasetError
+from graspexp.datasets.loader import load_object
+from graspexp.datasets.model import ObjectModel
+from graspexp.datasets.regions import import_meshlab_area
+
+__all__ = [
+    "DatasetError",
+    "ObjectModel",
+    "available_objects",
+    "dataset_objects",
+    "import_meshlab_area",
+    "load_object",
+    "primitives",
+    "resolve_root",
+]

@@ -1,0 +1,76 @@
+"""Command-line plumbing shared by the Hydra entry points: overrides are checked before Hydra runs,
+so a typo, a wrong type or an out-of-range value is one line on stderr and exit status 2."""
+
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+from graspexp.config import ConfigError, register_configs, validate
+
+CONF_DIR = str(Path(__file__).resolve().parent.parent / "conf")
+_VALUE_FLAGS = {"--cfg", "-c", "--package", "-p", "--config-path", "-cp", "--config-name", "-cn", "--config-dir", "-cd"}
+
+
+def split_argv(argv: list[str]) -> list[str]:
+    """The override tokens of a Hydra command line (flags and their values removed)."""
+    out, skip = [], False
+    for tok in argv:
+        if skip:
+            skip = False
+        elif tok in _VALUE_FLAGS:
+            skip = True
+        elif not tok.startswith("-"):
+            out.append(tok)
+    return out
+
+
+def _one_line(exc: BaseException) -> str:
+    text = str(exc) + ("\n" + str(exc.__cause__) if exc.__cause__ is not None else "")
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    msg = lines[0] if lines else type(exc).__name__
+    for i, ln in enumerate(lines):
+        if ln.startswith("Available options"):
+            opts = [o for o in lines[i + 1 :] if not o.startswith(("Config search path", "provider=", "base_"))]
+            return f"{msg}; {ln.rstrip(':')}: {', '.join(opts)}"
+    if len(lines) > 1 and lines[0].startswith(("Could not override", "Error merging override")):
+        detail = next((x for x in lines[1:] if not x.startswith(("To append", "full_key", "object_type"))), "")
+        return f"{msg} {detail}".strip()
+    return msg
+
+
+def check_overrides(overrides: list[str], config_name: str = "config") -> None:
+    """Compose every combination of the (possibly swept) overrides and validate it; exit 2 on error."""
+    from hydra import compose, initialize_config_dir
+    from hydra._internal.core_plugins.basic_sweeper import BasicSweeper
+    from hydra.core.global_hydra import GlobalHydra
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+
+    register_configs()
+    mine = [o for o in overrides if not o.lstrip("+~").startswith("hydra")]
+    try:
+        parsed = OverridesParser.create().parse_overrides(mine)
+        combos = [c for batch in BasicSweeper.split_arguments(parsed, None) for c in batch]
+        GlobalHydra.instance().clear()
+        with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
+            for combo in combos:
+                validate(compose(config_name, overrides=combo))
+    except ConfigError as exc:
+        fail(str(exc))
+    except Exception as exc:  # Hydra/OmegaConf errors: report the reason, not the traceback
+        fail(_one_line(exc))
+    finally:
+        GlobalHydra.instance().clear()
+
+
+def fail(message: str) -> None:
+    """Print ``graspexp: error: <message>`` on stderr and exit with status 2."""
+    print(f"graspexp: error: {message}", file=sys.stderr)
+    raise SystemExit(2)
+
+
+def run_checked(hydra_main: Callable[[], object], argv: list[str] | None = None) -> None:
+    """Check the command line's overrides, then hand over to the Hydra main function."""
+    argv = sys.argv[1:] if argv is None else argv
+    if not any(a in ("--help", "-h", "--hydra-help", "--info", "-i") for a in argv):
+        check_overrides(split_argv(argv))
+    hydra_main()

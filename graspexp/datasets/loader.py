@@ -1,0 +1,149 @@
+"""Loading an :class:`ObjectModel`: mesh (cached in-process), seeded surface cloud, grasping area, mass."""
+
+from __future__ import annotations
+
+import functools
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import trimesh
+
+from graspexp.datasets.catalog import (
+    LINEMOD_MM_TO_M,
+    YCB_MASS_KG,
+    check_object_name,
+    dataset_dir,
+    mesh_path,
+    resolve_root,
+)
+from graspexp.datasets.errors import DatasetError
+from graspexp.datasets.model import ObjectModel
+from graspexp.datasets.primitives import PRIMITIVES
+from graspexp.datasets.regions import area_mask, load_region_specs, regions_path
+
+MIN_VOLUME_M3 = 1e-9
+"""A mesh whose convex hull encloses less than this (1 mm^3) is degenerate (flat or a point)."""
+MESH_CACHE_SIZE = 64
+"""Meshes kept in the in-process cache (a google_16k mesh is about 1 MB)."""
+
+
+@dataclass(frozen=True)
+class MeshEntry:
+    """A validated mesh and the facts derived from it once (the cached value)."""
+
+    mesh: trimesh.Trimesh
+    """Object frame, metres, vertices merged by position. Never mutated: callers get copies."""
+    volume_m3: float
+    """Enclosed volume if the mesh is watertight, else the convex-hull volume (an upper bound)."""
+    watertight: bool
+
+
+def load_mesh(path: Path | str, scale: float = 1.0) -> MeshEntry:
+    """The validated mesh of ``path`` with coordinates multiplied by ``scale`` (file units -> metres).
+
+    Cached on (resolved path, modification time, scale): repeated trials do not reload. Textures and
+    materials are never decoded. Raises :class:`DatasetError` for an unreadable file, no faces,
+    non-finite vertices or zero volume.
+    """
+    resolved = Path(path).resolve()
+    try:
+        mtime_ns = resolved.stat().st_mtime_ns
+    except OSError as err:
+        raise DatasetError(f"cannot read mesh file {resolved}: {err.strerror}") from None
+    return _load_mesh_cached(resolved, mtime_ns, float(scale))
+
+
+@functools.lru_cache(maxsize=MESH_CACHE_SIZE)
+def _load_mesh_cached(path: Path, _mtime_ns: int, scale: float) -> MeshEntry:
+    try:
+        with warnings.catch_warnings():
+            # Some google_16k OBJ files hold a `vn nan nan nan` line; vertex normals are recomputed anyway.
+            warnings.simplefilter("ignore", RuntimeWarning)
+            loaded = trimesh.load(path, force="mesh", skip_materials=True, process=False)
+    except Exception as err:  # trimesh raises many types for malformed files
+        raise DatasetError(f"broken mesh {path}: cannot be loaded ({type(err).__name__}: {err})") from None
+    vertices = np.asarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=float)
+    faces = np.asarray(getattr(loaded, "faces", np.empty((0, 3))), dtype=np.int64)
+    return _validated(trimesh.Trimesh(vertices * scale, faces, process=True), str(path))
+
+
+@functools.lru_cache(maxsize=len(PRIMITIVES))
+def _primitive_entry(name: str) -> MeshEntry:
+    return _validated(PRIMITIVES[name](), f"primitive {name!r}")
+
+
+def _validated(mesh: trimesh.Trimesh, what: str) -> MeshEntry:
+    if len(mesh.faces) == 0:
+        raise DatasetError(f"broken mesh {what}: it has no faces")
+    if not np.all(np.isfinite(mesh.vertices)):
+        raise DatasetError(f"broken mesh {what}: it has non-finite vertex coordinates")
+    try:
+        hull_volume = float(mesh.convex_hull.volume)
+    except Exception:  # qhull fails on flat or collinear input
+        hull_volume = 0.0
+    if not hull_volume > MIN_VOLUME_M3:
+        raise DatasetError(f"broken mesh {what}: it encloses zero volume (flat or degenerate)")
+    watertight = bool(mesh.is_watertight)
+    if watertight and mesh.volume < 0:
+        mesh.invert()  # inside-out winding: make face normals point outwards
+    volume = float(mesh.volume) if watertight else hull_volume
+    mesh.vertices.flags.writeable = False
+    mesh.faces.flags.writeable = False
+    return MeshEntry(mesh=mesh, volume_m3=volume, watertight=watertight)
+
+
+def object_mesh(cfg: Any, name: str) -> tuple[MeshEntry, str]:
+    """The cached mesh entry of object ``name`` and its source file ("" for primitives)."""
+    check_object_name(cfg.name, name)
+    if cfg.name == "primitives":
+        return _primitive_entry(name), ""
+    path = mesh_path(cfg, name)
+    scale = LINEMOD_MM_TO_M if cfg.name == "linemod" else 1.0
+    return load_mesh(path, scale), str(path.resolve())
+
+
+def object_mass_kg(cfg: Any, name: str, entry: MeshEntry) -> float:
+    """YCB: the published mass. LINEMOD and primitives: volume x ``cfg.density_kg_m3``."""
+    if cfg.name == "ycb":
+        return YCB_MASS_KG[name]
+    density = float(cfg.density_kg_m3)
+    if not density > 0:
+        raise DatasetError(f"dataset.density_kg_m3 must be > 0, got {density}")
+    return entry.volume_m3 * density
+
+
+def load_object(cfg: Any, name: str, n_points: int, seed: int) -> ObjectModel:
+    """Load object ``name`` of dataset ``cfg`` (a DatasetConfig or its DictConfig).
+
+    n_points : number of surface samples (>= 1).
+    seed : seeds ``trimesh.sample.sample_surface`` (the same seed gives the same cloud; the global
+        ``np.random`` is never used). Derive it with :func:`graspexp.seeding.derive_seed`.
+    The grasping area comes from the spec file ``cfg.regions`` (see :mod:`graspexp.datasets.regions`).
+    """
+    if isinstance(n_points, bool) or not isinstance(n_points, int | np.integer) or n_points < 1:
+        raise DatasetError(f"n_points must be a positive integer, got {n_points!r}")
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer):
+        raise DatasetError(f"seed must be an integer, got {seed!r}")
+    entry, source = object_mesh(cfg, name)
+    specs_file = regions_path(cfg.regions)
+    specs = load_region_specs(specs_file)
+    if name not in specs:
+        raise DatasetError(f"no grasping-area spec for object {name!r} in {specs_file}; add an entry there")
+
+    mesh = entry.mesh.copy(include_cache=True)
+    points, face_index = trimesh.sample.sample_surface(mesh, int(n_points), seed=int(seed))
+    normals = mesh.face_normals[face_index]
+    mask = area_mask(specs[name], points, mesh.bounds, data_dirs=(dataset_dir(cfg), resolve_root(cfg)))
+    return ObjectModel(
+        name=name,
+        dataset=cfg.name,
+        mesh=mesh,
+        points=np.asarray(points, dtype=np.float64),
+        normals=np.asarray(normals, dtype=np.float64),
+        area_mask=mask,
+        mass_kg=object_mass_kg(cfg, name, entry),
+        source=source,
+    )

@@ -1,0 +1,126 @@
+"""The grasping cost of paper Eq. (1) (collaborative mode) and Eq. (2)-(3) (bin picking), vectorised.
+
+Units follow the paper, because its constants only make sense in them:
+
+- ``Y_ip`` (distance from object point ``i`` to the line of path ``p``) and ``r_k`` in MILLIMETRES;
+- ``alpha_p`` in DEGREES: the angle between two lines (the path and the main axis), in [0, 90]
+  (``arccos |d . a|``), so ``|alpha_p - 90|`` is 0 for a path orthogonal to the main axis;
+- ``beta_p`` in RADIANS: the angle between the path line and the support plane, in [0, pi/2]
+  (``arcsin |d_z|``), so the bin-picking term favours near-vertical (top-down) approaches;
+- ``d_k`` (height of the centre above the support plane, signed) and ``g`` (gripper stroke) in mm.
+
+Eq. (1):  J = (w |alpha - 90| + o) / s * sum_i min(cap, num / ((Y_ip - r_k)^2 + off))
+Eq. (2):  J_bin = J * T(d_k, beta_p)
+Eq. (3):  T = (beta_p - pi/2)^2 / b + t0   if d_k <= g,   else t_far
+
+with every constant taken from :class:`graspexp.config.CostConfig`.
+
+``Y_ip`` uses ``Y^2 = |x - c|^2 - ((x - c) . d)^2`` (``d`` unit), one matrix product per cluster. The
+per-element work runs in float32 on coordinates relative to the centre (mm): the squared-distance
+cancellation then loses at most ~1e-3 mm^2, which changes a summand by far less than 1e-4; sums
+use numpy's pairwise float32 summation (relative error ~1e-7). :func:`distance_term` with ``dtype=np.float64`` is the exact reference.
+"""
+
+import numpy as np
+
+from graspexp.config import CostConfig
+
+M_TO_MM = 1000.0
+
+
+def path_main_axis_angles_deg(directions: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """alpha_p: angle between each path line and the main-axis line, degrees in [0, 90].
+
+    directions : (..., 3) unit; axis : (3,) unit. Returns (...) float64.
+    """
+    c = np.clip(np.abs(directions @ axis), 0.0, 1.0)
+    return np.degrees(np.arccos(c))
+
+
+def path_table_angles_rad(directions: np.ndarray) -> np.ndarray:
+    """beta_p: angle between each path line and the horizontal support plane, radians in [0, pi/2]."""
+    return np.arcsin(np.clip(np.abs(directions[..., 2]), 0.0, 1.0))
+
+
+def angle_term(alpha_deg: np.ndarray, cost: CostConfig) -> np.ndarray:
+    """First factor of Eq. (1): ``(w |alpha_deg - target_deg| + offset) / divisor``."""
+    return (cost.angle_weight * np.abs(alpha_deg - cost.angle_target_deg) + cost.angle_offset) / cost.angle_divisor
+
+
+def table_term(d_k_mm: float, beta_rad: np.ndarray, g_mm: float, cost: CostConfig) -> np.ndarray:
+    """Eq. (3): ``(beta - target)^2 / divisor + offset`` when ``d_k_mm <= g_mm``, else ``table_far``."""
+    beta = np.asarray(beta_rad, dtype=np.float64)
+    if d_k_mm <= g_mm:
+        return (beta - cost.table_beta_target_rad) ** 2 / cost.table_beta_divisor + cost.table_offset
+    return np.full(beta.shape, float(cost.table_far))
+
+
+def distance_term(
+    rel_points_mm: np.ndarray,
+    directions: np.ndarray,
+    r_k_mm: float,
+    cost: CostConfig,
+    *,
+    dtype: type = np.float32,
+) -> np.ndarray:
+    """Second factor of Eq. (1) for every path of one cluster.
+
+    rel_points_mm : (N, 3) object points minus the cluster centre, millimetres.
+    directions : (M, 3) unit path directions (either sign: only the line matters).
+    r_k_mm : the cluster radius, millimetres.
+    dtype : working precision of the (M, N) block (float32 fast path, float64 reference).
+
+    Returns
+    -------
+    (M,) float64: ``sum_i min(cap, num / ((Y_ip - r_k)^2 + off))``.
+    """
+    x = np.asarray(rel_points_mm, dtype=dtype)
+    d = np.asarray(directions, dtype=dtype)
+    n = len(x)
+    sq = np.einsum("ij,ij->i", x, x)  # (N,) |x - c|^2
+    block = d @ np.ascontiguousarray(x.T)  # (M, N) (x - c) . d
+    np.square(block, out=block)
+    np.subtract(sq, block, out=block)  # Y^2; only rounding can make it negative, abs() absorbs that
+    np.abs(block, out=block)
+    np.sqrt(block, out=block)  # Y_ip, mm
+    block -= dtype(r_k_mm)
+    np.square(block, out=block)
+    block += dtype(cost.distance_offset_mm2)
+    np.divide(dtype(cost.distance_numerator_mm2), block, out=block)
+    # A row operand, not a scalar: numpy's scalar-broadcast minimum is several times slower here.
+    np.minimum(block, np.full(n, cost.distance_cap, dtype=dtype), out=block)
+    # numpy's pairwise summation along the contiguous axis keeps the float32 sum accurate (~1e-7).
+    return block.sum(axis=1).astype(np.float64)
+
+
+def cluster_costs(
+    points_m: np.ndarray,
+    center_m: np.ndarray,
+    r_k_m: float,
+    directions: np.ndarray,
+    axis: np.ndarray,
+    mode: str,
+    table_z_m: float,
+    gripper_max_width_m: float,
+    cost: CostConfig,
+    *,
+    dtype: type = np.float32,
+) -> np.ndarray:
+    """Eq. (1) (``mode == "collab"``) or Eq. (2) (``mode == "bin"``) for the paths of one cluster.
+
+    points_m : (N, 3) whole object cloud, world, metres; center_m : (3,) c_k; r_k_m : radius, metres;
+    directions : (M, 3) unit approach directions; axis : (3,) unit main axis.
+
+    Returns
+    -------
+    (M,) float64 costs (finite; feasibility is the caller's business).
+    """
+    if mode not in ("collab", "bin"):
+        raise ValueError(f"mode={mode!r} is invalid: expected one of collab, bin")
+    rel_mm = (np.asarray(points_m, dtype=np.float64) - center_m) * M_TO_MM
+    j = angle_term(path_main_axis_angles_deg(directions, axis), cost)
+    j = j * distance_term(rel_mm, directions, r_k_m * M_TO_MM, cost, dtype=dtype)
+    if mode == "bin":
+        d_k_mm = (float(center_m[2]) - table_z_m) * M_TO_MM
+        j = j * table_term(d_k_mm, path_table_angles_rad(directions), gripper_max_width_m * M_TO_MM, cost)
+    return j

@@ -1,0 +1,69 @@
+"""Grasping paths from a Fibonacci sphere (paper III-C) and the support-plane test (III-D, Fig. 8).
+
+Around each cluster centre ``c_k`` sits a sphere of radius ``R`` carrying ``M`` evenly spread points
+``c_k + R u_p`` (``u_p`` unit, a Fibonacci lattice). Path ``p`` of cluster ``k`` runs in a straight line
+from its sphere point to the centre, so its approach direction is ``d_p = -u_p``. The lattice is the
+same for every cluster; only the centre moves.
+
+A path is infeasible when its sphere point (the pre-grasp standoff) lies below the support plane
+``z = table_z + clearance``: the gripper would come up through the box/table top. Because the centre
+lies above the plane (it is a mean of surface points of an object standing on it), the whole segment is
+then above the plane exactly when the sphere point is.
+"""
+
+import numpy as np
+
+GOLDEN_ANGLE_RAD = np.pi * (3.0 - np.sqrt(5.0))
+"""Azimuth increment of the Fibonacci lattice, radians (about 137.5 degrees)."""
+
+
+def fibonacci_sphere(m: int) -> np.ndarray:
+    """``m`` evenly spread unit vectors.
+
+    Point ``i`` has height ``z_i = 1 - (2 i + 1) / m`` (equal-area bands, so ``sum z_i = 0``) and azimuth
+    ``i * golden_angle``.
+
+    Returns
+    -------
+    (m, 3) float64 unit vectors (norm 1 to rounding).
+    """
+    if m < 1:
+        raise ValueError(f"m={m!r} is invalid: expected a positive number of paths")
+    i = np.arange(m, dtype=np.float64)
+    z = 1.0 - (2.0 * i + 1.0) / m
+    rho = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
+    theta = i * GOLDEN_ANGLE_RAD
+    return np.stack([rho * np.cos(theta), rho * np.sin(theta), z], axis=1)
+
+
+def approach_directions(centers_m: np.ndarray, m: int) -> np.ndarray:
+    """Approach directions of every path.
+
+    centers_m : (K, 3) cluster centres, world, metres (only K is used: the lattice is shared).
+
+    Returns
+    -------
+    (K, m, 3) float64 unit vectors ``d = -u_p`` pointing from the sphere point towards the centre.
+    """
+    u = fibonacci_sphere(m)
+    return np.broadcast_to(-u, (len(centers_m), m, 3)).copy()
+
+
+def sphere_points(centers_m: np.ndarray, directions: np.ndarray, sphere_radius_m: float) -> np.ndarray:
+    """Start point ``c_k - R d`` (= ``c_k + R u_p``) of every path.
+
+    centers_m : (K, 3) world, metres; directions : (K, M, 3) unit approach directions.
+
+    Returns
+    -------
+    (K, M, 3) float64, world, metres.
+    """
+    return centers_m[:, None, :] - sphere_radius_m * directions
+
+
+def above_support(
+    centers_m: np.ndarray, directions: np.ndarray, sphere_radius_m: float, table_z_m: float, clearance_m: float
+) -> np.ndarray:
+    """(K, M) bool: True where the path's sphere point is at or above ``z = table_z_m + clearance_m``."""
+    start_z = centers_m[:, None, 2] - sphere_radius_m * directions[..., 2]
+    return start_z >= table_z_m + clearance_m

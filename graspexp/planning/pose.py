@@ -1,0 +1,84 @@
+"""The grasp frame of paper Fig. 9, the opening width, and the object-wider-than-gripper test.
+
+Frame
+    +Z = approach direction ``d`` (from the sphere point towards the centre); +X = main axis made
+    orthogonal to Z by Gram-Schmidt, ``a - (a . Z) Z`` normalised; +Y = Z x X (the closing axis).
+    Origin = cluster centre ``c_k``. When the main axis is within ``PARALLEL_TOL`` (sine of the angle)
+    of the approach, the X seed falls back to the world axis least aligned with Z (lowest index on a
+    tie), which is deterministic and never parallel to Z. The rotation is orthonormal with det +1.
+
+Width
+    ``clip(2 r_k (1 + width_margin), gripper.min_width_m, gripper.max_width_m)``, metres.
+
+Wider than the gripper
+    In the grasp frame, take the object points inside the pads' sweep: ``|x| <= finger_width/2`` and
+    ``|z| <= finger_length/2`` (pads centred on the grasp point). Their extent along Y (max - min) is the
+    object's section the fingers must close around; a path is unusable when that exceeds
+    ``gripper.max_width_m``. No points in the slab: extent 0 (nothing to squeeze, the test passes).
+"""
+
+import numpy as np
+
+from graspexp.config import GripperConfig
+
+PARALLEL_TOL = 1e-6
+"""Below this norm of the Gram-Schmidt residual the main axis counts as parallel to the approach."""
+
+
+def grasp_rotations(approaches: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """(B,3,3) rotations whose columns are X, Y, Z of the grasp frame (module doc), world.
+
+    approaches : (B, 3) approach directions (normalised here); axis : (3,) unit main axis.
+    """
+    z = np.asarray(approaches, dtype=np.float64).reshape(-1, 3)
+    z = z / np.linalg.norm(z, axis=1, keepdims=True)
+    a = np.asarray(axis, dtype=np.float64)
+    x = a - (z @ a)[:, None] * z
+    norm = np.linalg.norm(x, axis=1)
+    for b in np.flatnonzero(norm < PARALLEL_TOL):
+        seed = np.zeros(3)
+        seed[int(np.argmin(np.abs(z[b])))] = 1.0
+        x[b] = seed - np.dot(seed, z[b]) * z[b]
+        norm[b] = np.linalg.norm(x[b])
+    x = x / norm[:, None]
+    y = np.cross(z, x)
+    y = y / np.linalg.norm(y, axis=1, keepdims=True)
+    return np.stack([x, y, z], axis=2)
+
+
+def grasp_rotation(approach: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """(3,3) rotation whose columns are X, Y, Z of the grasp frame (module doc), world."""
+    return grasp_rotations(np.asarray(approach)[None], axis)[0]
+
+
+def grasp_pose(center_m: np.ndarray, approach: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """(4,4) world pose of the grasp frame: rotation from :func:`grasp_rotation`, origin ``center_m``."""
+    pose = np.eye(4)
+    pose[:3, :3] = grasp_rotation(approach, axis)
+    pose[:3, 3] = center_m
+    return pose
+
+
+def opening_width_m(r_k_m: float, width_margin: float, gripper: GripperConfig) -> float:
+    """Planned opening between the pads, metres (module doc)."""
+    return float(np.clip(2.0 * r_k_m * (1.0 + width_margin), gripper.min_width_m, gripper.max_width_m))
+
+
+def slab_extents_m(points_m: np.ndarray, center_m: np.ndarray, rotations: np.ndarray, gripper: GripperConfig) -> np.ndarray:
+    """Object extent along +Y inside the pads' sweep, for a batch of grasp frames.
+
+    points_m : (N, 3) world, metres; center_m : (3,); rotations : (B, 3, 3) grasp rotations.
+
+    Returns
+    -------
+    (B,) float64 extents, metres (0 where no point falls in the slab).
+    """
+    rel = np.asarray(points_m, dtype=np.float64) - center_m
+    local = rel @ rotations  # (B, N, 3) grasp-frame coordinates
+    inside = (np.abs(local[..., 0]) <= gripper.finger_width_m / 2) & (
+        np.abs(local[..., 2]) <= gripper.finger_length_m / 2
+    )
+    y = local[..., 1]
+    hi = np.where(inside, y, -np.inf).max(axis=1)
+    lo = np.where(inside, y, np.inf).min(axis=1)
+    return np.where(inside.any(axis=1), hi - lo, 0.0)

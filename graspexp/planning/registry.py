@@ -1,0 +1,44 @@
+"""Planners chosen by name: ``planner.name`` in the config is the key of :data:`PLANNERS`.
+
+Every planner is a pure function ``PlanRequest -> PlanResult``. Add one with
+``register_planner("name", fn)`` (or ``PLANNERS["name"] = fn``) from the module that defines it.
+"""
+
+from collections.abc import Callable
+
+from graspexp.planning.optimal import NAME as OPTIMAL_NAME
+from graspexp.planning.optimal import plan_optimal
+from graspexp.planning.request import PlanRequest, PlanResult
+
+Planner = Callable[[PlanRequest], PlanResult]
+
+PLANNERS: dict[str, Planner] = {OPTIMAL_NAME: plan_optimal}
+
+
+class UnknownPlanner(KeyError):
+    """``planner.name`` names no registered planner."""
+
+    def __str__(self) -> str:  # KeyError would quote the whole message
+        return str(self.args[0])
+
+
+def register_planner(name: str, fn: Planner) -> Planner:
+    """Register ``fn`` under ``name`` (a name may be registered once); returns ``fn``."""
+    if name in PLANNERS and PLANNERS[name] is not fn:
+        raise ValueError(f"planner {name!r} is already registered")
+    PLANNERS[name] = fn
+    return fn
+
+
+def get_planner(name: str) -> Planner:
+    """The planner registered as ``name``; an unknown name raises :class:`UnknownPlanner` listing the valid ones."""
+    try:
+        return PLANNERS[name]
+    except KeyError:
+        valid = ", ".join(sorted(PLANNERS))
+        raise UnknownPlanner(f"planner.name={name!r} is unknown: expected one of {valid}") from None
+
+
+def plan(req: PlanRequest) -> PlanResult:
+    """Dispatch on ``req.planner.name``."""
+    return get_planner(req.planner.name)(req)

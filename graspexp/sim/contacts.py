@@ -1,0 +1,63 @@
+"""Contact queries on a live scene: the one place that decides what "touching" and "holding" mean."""
+
+import numpy as np
+import sapien
+
+from graspexp.sim.gripper import FINGER_NAMES
+from graspexp.sim.scene import OBJECT_NAME, SUPPORT_NAME
+
+GRIPPER_LINKS = frozenset({*FINGER_NAMES, "palm"})
+MIN_IMPULSE_NS = 1e-9
+"""Contact points with a smaller impulse are proximity reports inside contact_offset, not touches."""
+
+
+def _pair_names(contact: sapien.physx.PhysxContact) -> tuple[str, str]:
+    return contact.bodies[0].entity.name, contact.bodies[1].entity.name
+
+
+def _touching(contact: sapien.physx.PhysxContact) -> bool:
+    return any(np.linalg.norm(p.impulse) > MIN_IMPULSE_NS for p in contact.points)
+
+
+def finger_forces(contacts: list, dt: float) -> dict[str, float]:
+    """|total contact force| between the object and each finger over the last step, N."""
+    out = dict.fromkeys(FINGER_NAMES, 0.0)
+    for c in contacts:
+        a, b = _pair_names(c)
+        if OBJECT_NAME in (a, b):
+            other = b if a == OBJECT_NAME else a
+            if other in out:
+                impulse = np.sum([p.impulse for p in c.points], axis=0)
+                out[other] += float(np.linalg.norm(impulse)) / dt
+    return out
+
+
+def gripper_touches_support(contacts: list) -> bool:
+    """True if any gripper link presses on the support in the last step."""
+    for c in contacts:
+        a, b = _pair_names(c)
+        if SUPPORT_NAME in (a, b) and (a in GRIPPER_LINKS or b in GRIPPER_LINKS) and _touching(c):
+            return True
+    return False
+
+
+def contact_records(contacts: list, dt: float) -> list[dict]:
+    """Every touching contact point as a plain dict for the log (world frame, N, m)."""
+    out = []
+    for c in contacts:
+        a, b = _pair_names(c)
+        for p in c.points:
+            impulse = np.asarray(p.impulse, dtype=float)
+            if np.linalg.norm(impulse) <= MIN_IMPULSE_NS:
+                continue
+            out.append(
+                {
+                    "body0": a,
+                    "body1": b,
+                    "position": [float(v) for v in p.position],
+                    "normal": [float(v) for v in p.normal],
+                    "force_n": [float(v) for v in impulse / dt],
+                    "separation_m": float(p.separation),
+                }
+            )
+    return out

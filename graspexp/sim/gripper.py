@@ -1,0 +1,136 @@
+"""The parallel gripper as a SAPIEN articulation built from ``conf/gripper/*``.
+
+Chain: fixed root at the grasp frame's orientation -> prismatic x, y, z (driven, in the grasp frame)
+-> ``palm`` (the TCP frame: origin midway between the pads, +Z approach, +Y closing axis)
+-> ``finger_left`` (+Y) and ``finger_right`` (-Y), prismatic, force-limited drives.
+A finger joint value q is the distance of that finger's inner face from the TCP along +-Y, metres.
+The gripper only translates during a trial (the paper moves the end effector to the grasp pose and
+then extends / pulls back), so the root carries the grasp orientation and no rotational joints exist.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import sapien
+
+from graspexp.config import GripperConfig
+from graspexp.geometry import matrix_to_quat_wxyz
+from graspexp.sim.scene import GRIPPER_BIT, OBJECT_BIT, SUPPORT_BIT, set_groups
+
+# wxyz quaternions that turn a joint's +x axis onto the named axis
+_AXIS_Q = {
+    "x": [1.0, 0.0, 0.0, 0.0],
+    "y": [np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4)],
+    "-y": [np.cos(np.pi / 4), 0.0, 0.0, -np.sin(np.pi / 4)],
+    "z": [np.cos(np.pi / 4), 0.0, -np.sin(np.pi / 4), 0.0],
+}
+FINGER_NAMES = ("finger_left", "finger_right")
+PALM_NAME = "palm"
+ARM_STIFFNESS, ARM_DAMPING, ARM_FORCE_N = 2.0e4, 4.0e2, 400.0
+FINGER_STIFFNESS, FINGER_DAMPING = 2.0e3, 1.0e2
+COUPLING_STIFFNESS, COUPLING_DAMPING = 1.0e5, 1.0e3
+"""Fixed tendon that keeps both fingers at the same opening (N/m, N s/m)."""
+CLOSE_PAST_M = 0.02
+"""Finger target beyond fully closed, so the drive saturates at the grip force."""
+
+
+@dataclass
+class Gripper:
+    articulation: sapien.physx.PhysxArticulation
+    palm: sapien.physx.PhysxArticulationLinkComponent
+    fingers: tuple[sapien.physx.PhysxArticulationLinkComponent, sapien.physx.PhysxArticulationLinkComponent]
+    joints: list
+    root_pose: np.ndarray
+    """(4,4) world pose of the root = grasp frame at zero joint offsets."""
+
+    def set_state(self, offset: np.ndarray, half_width_m: float) -> None:
+        """Teleport to TCP offset (3,) in the grasp frame, fingers at ``half_width_m``; zero velocity."""
+        q = np.array([*offset, half_width_m, half_width_m], dtype=np.float32)
+        self.articulation.set_qpos(q)
+        self.articulation.set_qvel(np.zeros_like(q))
+        self.drive_arm(offset)
+        self.drive_fingers(half_width_m)
+
+    def drive_arm(self, offset: np.ndarray) -> None:
+        """Position targets of the x, y, z joints: TCP offset in the grasp frame, metres."""
+        for joint, value in zip(self.joints[:3], offset):
+            joint.set_drive_target(float(value))
+
+    def drive_fingers(self, half_width_m: float) -> None:
+        for joint in self.joints[3:]:
+            joint.set_drive_target(float(half_width_m))
+
+    def close(self) -> None:
+        """Drive the fingers past closed: each presses with the configured grip force."""
+        self.drive_fingers(-CLOSE_PAST_M)
+
+    def finger_opening(self) -> float:
+        """Current distance between the pads, m."""
+        q = self.articulation.get_qpos()
+        return float(q[3] + q[4])
+
+    def tcp_pose(self) -> np.ndarray:
+        """(4,4) world pose of the TCP (palm link frame)."""
+        return self.palm.entity_pose.to_transformation_matrix()
+
+
+def build_gripper(scene: sapien.Scene, cfg: GripperConfig, grasp_pose: np.ndarray, support_collides: bool) -> Gripper:
+    """Build the gripper with its root at ``grasp_pose`` ((4,4) world); fingers open to the stroke."""
+    ab = scene.create_articulation_builder()
+    pad = sapien.physx.PhysxMaterial(cfg.pad_friction, cfg.pad_friction, 0.0)
+    link = ab.create_link_builder()
+    link.set_name("root")
+    link.set_mass_and_inertia(0.1, sapien.Pose(), [1e-4] * 3)
+    for axis in ("x", "y", "z"):
+        link = ab.create_link_builder(link)
+        link.set_name(f"slide_{axis}")
+        link.set_joint_name(f"slide_{axis}")
+        q = _AXIS_Q[axis]
+        link.set_joint_properties("prismatic", [[-1.0, 1.0]], sapien.Pose(q=q), sapien.Pose(q=q))
+        link.set_mass_and_inertia(0.1, sapien.Pose(), [1e-4] * 3)
+    palm = link
+    palm.set_name(PALM_NAME)
+    L = float(cfg.finger_length_m)
+    root_z = -0.75 * L  # finger roots (palm face) sit 3/4 of a finger behind the TCP
+    px, py, pz = cfg.palm_size_m
+    palm.add_box_collision(sapien.Pose([0.0, 0.0, root_z - pz / 2]), half_size=[px / 2, py / 2, pz / 2], material=pad)
+    for name, axis, sign in (("finger_left", "y", 1.0), ("finger_right", "-y", -1.0)):
+        f = ab.create_link_builder(palm)
+        f.set_name(name)
+        f.set_joint_name(name)
+        q = _AXIS_Q[axis]
+        f.set_joint_properties("prismatic", [[0.0, cfg.max_width_m / 2]], sapien.Pose(q=q), sapien.Pose(q=q))
+        t = float(cfg.finger_thickness_m)
+        center = [0.0, sign * t / 2, root_z + L / 2]
+        f.add_box_collision(
+            sapien.Pose(center), half_size=[cfg.finger_width_m / 2, t / 2, L / 2], material=pad, density=1000.0
+        )
+        f.set_mass_and_inertia(cfg.finger_mass_kg, sapien.Pose(center), [1e-5] * 3)
+    art = ab.build(fix_root_link=True)
+    art.name = "gripper"
+    art.set_root_pose(sapien.Pose(grasp_pose[:3, 3], matrix_to_quat_wxyz(grasp_pose[:3, :3])))
+    mask = OBJECT_BIT | (SUPPORT_BIT if support_collides else 0)
+    for lk in art.links:
+        lk.disable_gravity = True
+        set_groups(lk, GRIPPER_BIT, mask)
+    joints = list(art.active_joints)
+    for j in joints[:3]:
+        j.set_drive_properties(stiffness=ARM_STIFFNESS, damping=ARM_DAMPING, force_limit=ARM_FORCE_N)
+    for j in joints[3:]:
+        j.set_drive_properties(stiffness=FINGER_STIFFNESS, damping=FINGER_DAMPING, force_limit=float(cfg.grip_force_n))
+    links = {lk.name: lk for lk in art.links}
+    # couple the fingers like a real parallel gripper's linkage: q_left - q_right -> 0, stiffly
+    art.create_fixed_tendon(
+        [links[PALM_NAME], links["finger_left"], links["finger_right"]],
+        [0.0, 1.0, -1.0],
+        [0.0, 1.0, -1.0],
+        stiffness=COUPLING_STIFFNESS,
+        damping=COUPLING_DAMPING,
+    )
+    return Gripper(
+        articulation=art,
+        palm=links[PALM_NAME],
+        fingers=(links["finger_left"], links["finger_right"]),
+        joints=joints,
+        root_pose=grasp_pose,
+    )

@@ -1,0 +1,108 @@
+"""A fresh physics-only SAPIEN scene per trial: the support and the dropped object.
+
+World frame: z up, metres. The support is a static box whose top is the plane z = h
+(``mode.support_height_m``). Collision filtering uses SAPIEN's groups: two shapes collide when
+``(A[0] & B[1]) or (A[1] & B[0])``; the bits below say what each body is and what it touches.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+import sapien
+
+from graspexp.config import ModeConfig, SimConfig
+from graspexp.geometry import matrix_to_quat_wxyz, quat_wxyz_to_matrix
+
+OBJECT_BIT, SUPPORT_BIT, GRIPPER_BIT = 1, 2, 4
+OBJECT_NAME, SUPPORT_NAME = "object", "support"
+
+
+def configure_physx(cfg: SimConfig) -> None:
+    """Global PhysX settings; must run before each scene is created."""
+    sapien.physx.set_scene_config(
+        gravity=np.array([0.0, 0.0, -9.81]),
+        enable_tgs=bool(cfg.enable_tgs),
+        enable_enhanced_determinism=True,
+        cpu_workers=0,
+    )
+    sapien.physx.set_body_config(
+        solver_position_iterations=int(cfg.solver_position_iterations),
+        solver_velocity_iterations=int(cfg.solver_velocity_iterations),
+        sleep_threshold=0.0,
+    )
+    sapien.physx.set_shape_config(contact_offset=float(cfg.contact_offset_m), rest_offset=float(cfg.rest_offset_m))
+
+
+def set_groups(component: sapien.physx.PhysxRigidBaseComponent, member: int, collides_with: int) -> None:
+    """Give every collision shape of ``component`` the membership and mask bits."""
+    for shape in component.get_collision_shapes():
+        shape.set_collision_groups([member, collides_with, 0, 0])
+
+
+@dataclass
+class TrialScene:
+    """The live scene of one trial and handles to its bodies."""
+
+    scene: sapien.Scene
+    object_entity: sapien.Entity
+    object_body: sapien.physx.PhysxRigidDynamicComponent
+    support: sapien.Entity | None
+    table_z: float
+
+    def object_pose(self) -> np.ndarray:
+        """(4,4) world pose of the object frame."""
+        p = self.object_entity.pose
+        T = np.eye(4)
+        T[:3, :3] = quat_wxyz_to_matrix(p.q)
+        T[:3, 3] = p.p
+        return T
+
+    def remove_support(self) -> None:
+        if self.support is not None:
+            self.scene.remove_entity(self.support)
+            self.support = None
+
+
+def build_scene(
+    hulls: list[np.ndarray],
+    mass_kg: float,
+    drop_pose: np.ndarray,
+    mode: ModeConfig,
+    sim: SimConfig,
+) -> TrialScene:
+    """Create the scene with the support and the object at ``drop_pose`` ((4,4), world, m).
+
+    The object is one dynamic body with one convex shape per hull; its total mass is ``mass_kg``.
+    In collab mode the support collides with the object only (paper IV-A); in bin mode also with the gripper.
+    """
+    configure_physx(sim)
+    scene = sapien.Scene([sapien.physx.PhysxCpuSystem()])
+    scene.set_timestep(float(sim.timestep_s))
+    h = float(mode.support_height_m)
+
+    support_mat = sapien.physx.PhysxMaterial(sim.support_friction, sim.support_friction, 0.0)
+    builder = scene.create_actor_builder()
+    hx, hy = mode.support_half_size_m
+    builder.add_box_collision(half_size=[hx, hy, h / 2], material=support_mat)
+    builder.set_initial_pose(sapien.Pose([0.0, 0.0, h / 2]))
+    support = builder.build_static(SUPPORT_NAME)
+    support_mask = OBJECT_BIT | (GRIPPER_BIT if mode.support_collides_with_gripper else 0)
+    set_groups(support.find_component_by_type(sapien.physx.PhysxRigidStaticComponent), SUPPORT_BIT, support_mask)
+
+    obj_mat = sapien.physx.PhysxMaterial(sim.object_static_friction, sim.object_dynamic_friction, 0.0)
+    body = sapien.physx.PhysxRigidDynamicComponent()
+    for verts in hulls:
+        shape = sapien.physx.PhysxCollisionShapeConvexMesh(vertices=verts, scale=[1.0, 1.0, 1.0], material=obj_mat)
+        shape.set_density(1000.0)
+        body.attach(shape)
+    if len(body.get_collision_shapes()) != len(hulls):
+        raise RuntimeError(f"PhysX dropped {len(hulls) - len(body.get_collision_shapes())} of {len(hulls)} hulls")
+    entity = sapien.Entity()
+    entity.name = OBJECT_NAME
+    entity.add_component(body)
+    entity.pose = sapien.Pose(drop_pose[:3, 3], matrix_to_quat_wxyz(drop_pose[:3, :3]))
+    scene.add_entity(entity)
+    body.mass = float(mass_kg)
+    body.angular_damping = float(sim.object_angular_damping)
+    set_groups(body, OBJECT_BIT, SUPPORT_BIT | GRIPPER_BIT)
+    return TrialScene(scene=scene, object_entity=entity, object_body=body, support=support, table_z=h)

@@ -1,0 +1,355 @@
+"""The trial protocol (paper IV-A, IV-C, IV-D): drop, settle, plan, approach, close, then
+remove the box and hold (collab) or pull back and lift (bin). Staged checks stop at the first failure.
+"""
+
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+
+import numpy as np
+from omegaconf import DictConfig, OmegaConf
+
+from graspexp.config import JobConfig
+
+from graspexp.datasets.model import ObjectModel
+from graspexp.geometry import axis_angle_matrix, make_pose, random_rotation, transform_points, yaw_rotation
+from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
+from graspexp.planning.registry import plan
+from graspexp.planning.request import PlanRequest
+from graspexp.seeding import derive_seed, rng_for
+from graspexp.sim.contacts import contact_records, finger_forces, gripper_touches_support
+from graspexp.sim.gripper import FINGER_NAMES, Gripper, build_gripper
+from graspexp.sim.outcome import FailureReason, TrialResult
+from graspexp.sim.scene import TrialScene, build_scene
+
+MIN_FINGER_FORCE_N = 0.5
+"""A finger holds the object when it presses with at least this force."""
+
+
+class TrialFailed(Exception):
+    """Raised inside a trial at the first failed check; carries the reason."""
+
+    def __init__(self, reason: FailureReason, detail: str = ""):
+        super().__init__(f"{reason.value}: {detail}" if detail else reason.value)
+        self.reason = reason
+
+
+class NullRecorder:
+    """Stands in for a :class:`graspexp.record.TrialRecorder` when logging is off."""
+
+    def __getattr__(self, name):
+        return lambda *args, **kwargs: None
+
+
+@dataclass
+class TrialContext:
+    """Inputs of one trial. ``trial_seed`` derives every random draw of the trial."""
+
+    cfg: JobConfig
+    """The resolved job config as plain dataclasses (``OmegaConf.to_object``): fast attribute access."""
+    model: ObjectModel
+    hulls: list[np.ndarray]
+    trial: int
+    trial_seed: int
+    recorder: object = field(default_factory=NullRecorder)
+
+
+def plain_config(cfg: JobConfig) -> JobConfig:
+    """The composed job config as dataclass instances (attribute access in the step loop must be cheap)."""
+    return OmegaConf.to_object(cfg)
+
+
+def trial_seed(cfg: JobConfig, object_name: str, trial: int) -> int:
+    """Seed of one trial from (global seed, dataset, object, trial index)."""
+    return derive_seed(cfg.seed, cfg.dataset.name, object_name, trial)
+
+
+def drop_pose(model: ObjectModel, rot: str, table_z: float, gap_m: float, rng: np.random.Generator) -> np.ndarray:
+    """(4,4) world pose at release: rotated (about Z for ``z``, uniformly for ``xyz``), centred over the
+    support, lowest point ``gap_m`` above the support plane."""
+    R = yaw_rotation(rng.uniform(0.0, 2.0 * np.pi)) if rot == "z" else random_rotation(rng)
+    v = model.mesh.vertices @ R.T
+    lo, hi = v.min(axis=0), v.max(axis=0)
+    t = np.array([-(lo[0] + hi[0]) / 2, -(lo[1] + hi[1]) / 2, table_z + gap_m - lo[2]])
+    return make_pose(R, t)
+
+
+def perceived_pose(true_pose: np.ndarray, trans_mm: float, rot_deg: float, rng: np.random.Generator) -> np.ndarray:
+    """The pose the planner sees: Gaussian translation (std ``trans_mm``) and a rotation about a random axis
+    by a Gaussian angle (std ``rot_deg``) about the object's origin. Zero noise returns the pose unchanged."""
+    if trans_mm == 0 and rot_deg == 0:
+        return true_pose.copy()
+    axis = rng.normal(size=3)
+    dR = axis_angle_matrix(axis, np.deg2rad(rng.normal(0.0, rot_deg)))
+    out = true_pose.copy()
+    out[:3, :3] = dR @ true_pose[:3, :3]
+    out[:3, 3] += rng.normal(0.0, trans_mm, size=3) / 1000.0
+    return out
+
+
+class _Sim:
+    """Steps one trial's scene, keeps sim time, checks stability and table touches, logs at a fixed rate."""
+
+    def __init__(self, ts: TrialScene, cfg: JobConfig, recorder, timings: dict[str, float]):
+        self.ts, self.cfg, self.rec, self.timings = ts, cfg, recorder, timings
+        self.dt = float(cfg.sim.timestep_s)
+        self.t, self.steps = 0.0, 0
+        self.log_every = max(1, round(1.0 / (cfg.sim.log_rate_hz * self.dt)))
+        self.gripper: Gripper | None = None
+        self.watch_support = False
+        self.touched_support = False
+        self.max_speed_sq = float(cfg.sim.max_speed_mps) ** 2
+
+    def run(self, seconds: float, each_step=None) -> None:
+        n = max(1, int(round(seconds / self.dt)))
+        for i in range(n):
+            if each_step is not None:
+                each_step((i + 1) / n)
+            self.step()
+
+    def step(self) -> None:
+        self.ts.scene.step()
+        self.steps += 1
+        self.t = self.steps * self.dt
+        self._check_stable()
+        if self.watch_support and gripper_touches_support(self.ts.scene.get_contacts()):
+            self.touched_support = True
+            self.log()
+            raise TrialFailed(FailureReason.COLLISION_SUPPORT, f"gripper touched the support at t={self.t:.3f} s")
+        if self.steps % self.log_every == 0:
+            self.log()
+
+    def _check_stable(self) -> None:
+        body = self.ts.object_body
+        v, w = body.linear_velocity, body.angular_velocity
+        vv, ww = float(v @ v), float(w @ w)
+        if not (vv <= self.max_speed_sq and ww < 1e12):  # NaN fails every comparison
+            raise TrialFailed(FailureReason.SIM_UNSTABLE, f"object speed {vv**0.5:.3g} m/s at t={self.t:.3f} s")
+
+    def frames(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """World poses (position, quaternion wxyz) of the logged frames."""
+        p = self.ts.object_entity.pose
+        out = {"object": (p.p, p.q)}
+        if self.gripper is not None:
+            for link in (self.gripper.palm, *self.gripper.fingers):
+                lp = link.entity_pose
+                out[link.name] = (lp.p, lp.q)
+        return out
+
+    def log(self) -> None:
+        t0 = time.perf_counter()
+        self.rec.transforms(self.t, self.frames())
+        self.rec.contacts(self.t, contact_records(self.ts.scene.get_contacts(), self.dt))
+        self.timings["log"] += time.perf_counter() - t0
+
+    @contextmanager
+    def timed(self, name: str) -> Iterator[None]:
+        """Add the wall time of the block to ``timings[name]``, less the time spent logging in it."""
+        t0, log0 = time.perf_counter(), self.timings["log"]
+        try:
+            yield
+        finally:
+            self.timings[name] += time.perf_counter() - t0 - (self.timings["log"] - log0)
+
+    def phase(self, name: str, info: dict | None = None) -> None:
+        t0 = time.perf_counter()
+        self.rec.phase(self.t, name, info or {})
+        self.timings["log"] += time.perf_counter() - t0
+
+
+def _settle(sim: _Sim) -> bool:
+    """Step until the object rests (or the time cap); True if it is still on the support."""
+    cfg = sim.cfg.sim
+    body = sim.ts.object_body
+    min_steps = int(cfg.settle_min_s / sim.dt)
+    for _ in range(int(cfg.settle_max_s / sim.dt)):
+        sim.step()
+        if sim.steps >= min_steps and (
+            np.linalg.norm(body.linear_velocity) < cfg.settle_linear_mps
+            and np.linalg.norm(body.angular_velocity) < cfg.settle_angular_radps
+        ):
+            break
+    return _on_support(sim.ts, sim.cfg)
+
+
+def _on_support(ts: TrialScene, cfg: JobConfig) -> bool:
+    lo = ts.object_body.compute_global_aabb_tight()[0]
+    com = ts.object_entity.pose.p
+    hx, hy = cfg.mode.support_half_size_m
+    return bool(lo[2] > ts.table_z - 0.01 and abs(com[0]) <= hx and abs(com[1]) <= hy)
+
+
+def _scene_entities(ctx: TrialContext, table_z: float) -> list[dict]:
+    from graspexp.record import box_entity, mesh_entity
+    from graspexp.sim.collision import hull_meshes
+
+    mode = ctx.cfg.mode
+    hx, hy = mode.support_half_size_m
+    ents = [box_entity("support", "world", [0.0, 0.0, table_z / 2], [2 * hx, 2 * hy, table_z], [0.6, 0.45, 0.3, 1.0])]
+    for i, m in enumerate(hull_meshes(ctx.hulls)):
+        ents.append(mesh_entity(f"object_hull_{i}", "object", m.vertices, m.faces, [0.2, 0.4, 0.9, 1.0]))
+    return ents
+
+
+def _gripper_entities(cfg: JobConfig) -> list[dict]:
+    from graspexp.record import box_entity
+
+    g = cfg.gripper
+    L, t = g.finger_length_m, g.finger_thickness_m
+    root_z = -0.75 * L
+    px, py, pz = g.palm_size_m
+    grey = [0.5, 0.5, 0.5, 1.0]
+    ents = [box_entity("palm", "palm", [0.0, 0.0, root_z - pz / 2], [px, py, pz], grey)]
+    for name, sign in zip(FINGER_NAMES, (1.0, -1.0)):
+        ents.append(box_entity(name, name, [0.0, sign * t / 2, root_z + L / 2], [g.finger_width_m, t, L], grey))
+    return ents
+
+
+def _grasp_record(grasp: Grasp) -> dict:
+    return {
+        "pose": grasp.pose.tolist(),
+        "width_m": grasp.width_m,
+        "cost": grasp.cost,
+        "cluster": grasp.cluster,
+        "path": grasp.path,
+        "planner": grasp.planner,
+        "n_feasible": grasp.n_feasible,
+        "approach": grasp.approach.tolist(),
+        **{k: v for k, v in grasp.extras.items() if isinstance(v, (int, float, str))},
+    }
+
+
+def run_trial(ctx: TrialContext) -> TrialResult:
+    """Run one trial; never raises for a physical failure (the reason is in the result)."""
+    cfg = ctx.cfg
+    res = TrialResult(
+        dataset=cfg.dataset.name,
+        object=ctx.model.name,
+        mode=cfg.mode.name,
+        rot=cfg.rot.name,
+        planner=cfg.planner.name,
+        trial=ctx.trial,
+        seed=ctx.trial_seed,
+        success=False,
+        reason=None,
+    )
+    timings = dict.fromkeys(("build", "settle", "plan", "execute", "log"), 0.0)
+    sim: _Sim | None = None
+    try:
+        sim = _drop_until_on_support(ctx, res, timings)
+        with sim.timed("plan"):
+            grasp = _plan(ctx, sim)
+        res.grasp_cost, res.grasp_width_m, res.n_feasible = grasp.cost, grasp.width_m, grasp.n_feasible
+        with sim.timed("execute"):
+            _execute(ctx, sim, grasp, res)
+        res.success = True
+    except TrialFailed as e:
+        res.reason = e.reason.value
+        if sim is not None:
+            sim.phase("failed", {"reason": e.reason.value, "detail": str(e)})
+    if sim is not None:
+        res.touched_support = sim.touched_support
+        res.sim_time_s, res.steps = sim.t, sim.steps
+    res.timings_s = timings
+    ctx.recorder.result(sim.t if sim else 0.0, res.to_dict())
+    return res
+
+
+def _drop_until_on_support(ctx: TrialContext, res: TrialResult, timings: dict) -> _Sim:
+    cfg = ctx.cfg
+    for attempt in range(cfg.sim.max_redrops + 1):
+        rng = rng_for(ctx.trial_seed, "drop", attempt)
+        t0 = time.perf_counter()
+        pose = drop_pose(ctx.model, cfg.rot.name, cfg.mode.support_height_m, cfg.rot.drop_height_m, rng)
+        ts = build_scene(ctx.hulls, ctx.model.mass_kg, pose, cfg.mode, cfg.sim)
+        timings["build"] += time.perf_counter() - t0
+        sim = _Sim(ts, cfg, ctx.recorder, timings)
+        if attempt == 0:
+            ctx.recorder.scene(0.0, _scene_entities(ctx, ts.table_z))
+        sim.phase("drop", {"attempt": attempt})
+        with sim.timed("settle"):
+            on_support = _settle(sim)
+        if on_support:
+            sim.phase("settled", {"redrops": attempt})
+            return sim
+        res.redrops = attempt + 1
+    raise TrialFailed(FailureReason.FELL_OFF_SUPPORT, f"{cfg.sim.max_redrops + 1} drops fell off the support")
+
+
+def _plan(ctx: TrialContext, sim: _Sim) -> Grasp:
+    cfg = ctx.cfg
+    t0 = time.perf_counter()
+    noise = cfg.perception.noise
+    seen = perceived_pose(sim.ts.object_pose(), noise.trans_mm, noise.rot_deg, rng_for(ctx.trial_seed, "noise"))
+    req = PlanRequest(
+        points=transform_points(seen, ctx.model.points),
+        normals=ctx.model.normals @ seen[:3, :3].T,
+        area_mask=ctx.model.area_mask,
+        object_pose=seen,
+        table_z=sim.ts.table_z,
+        mode=cfg.mode.name,
+        gripper=cfg.gripper,
+        planner=cfg.planner,
+        cost=cfg.cost,
+        seed=derive_seed(ctx.trial_seed, "plan"),
+    )
+    try:
+        grasp = plan(req).grasp
+    except NoFeasibleGrasp as e:
+        raise TrialFailed(FailureReason.NO_FEASIBLE_GRASP, str(e)) from None
+    sim.phase("plan", {"plan_ms": 1e3 * (time.perf_counter() - t0)})
+    ctx.recorder.grasp(sim.t, _grasp_record(grasp))
+    return grasp
+
+
+def _held(sim: _Sim) -> dict[str, float]:
+    return finger_forces(sim.ts.scene.get_contacts(), sim.dt)
+
+
+def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> None:
+    cfg = ctx.cfg
+    mode, scfg = cfg.mode, cfg.sim
+    ts = sim.ts
+    gripper = build_gripper(ts.scene, cfg.gripper, grasp.pose, mode.support_collides_with_gripper)
+    sim.gripper = gripper
+    ctx.recorder.scene(sim.t, _gripper_entities(cfg))
+    sim.watch_support = bool(mode.support_collides_with_gripper)
+    standoff = float(cfg.planner.sphere_radius_m)
+    half = grasp.width_m / 2
+    gripper.set_state(np.array([0.0, 0.0, -standoff]), half)
+
+    sim.phase("approach", {"standoff_m": standoff, "width_m": grasp.width_m})
+    sim.run(standoff / scfg.approach_speed_mps, lambda s: gripper.drive_arm(np.array([0.0, 0.0, -standoff * (1 - s)])))
+    sim.phase("close")
+    gripper.close()
+    sim.run(scfg.close_s)
+    forces = _held(sim)
+    if min(forces.values()) < MIN_FINGER_FORCE_N:
+        res.finger_force_n = [forces[n] for n in FINGER_NAMES]
+        raise TrialFailed(FailureReason.NO_CONTACT, f"finger forces after closing {forces} N")
+
+    rel0 = np.linalg.inv(gripper.tcp_pose()) @ ts.object_pose()
+    if mode.remove_support_after_grasp:
+        sim.phase("remove_support")
+        ts.remove_support()
+    if mode.pull_back_m > 0:
+        sim.phase("pull_back", {"distance_m": mode.pull_back_m})
+        sim.run(mode.pull_back_m / scfg.retract_speed_mps, lambda s: gripper.drive_arm(np.array([0, 0, -mode.pull_back_m * s])))
+    if mode.lift_m > 0:
+        sim.phase("lift", {"distance_m": mode.lift_m})
+        start = np.array([0.0, 0.0, -mode.pull_back_m])
+        up = grasp.pose[:3, :3].T @ np.array([0.0, 0.0, mode.lift_m])
+        sim.run(mode.lift_m / scfg.retract_speed_mps, lambda s: gripper.drive_arm(start + s * up))
+    sim.phase("hold", {"duration_s": mode.hold_s})
+    sim.run(mode.hold_s)
+    forces = _held(sim)
+    res.finger_force_n = [forces[n] for n in FINGER_NAMES]
+    rel1 = np.linalg.inv(gripper.tcp_pose()) @ ts.object_pose()
+    res.slip_m = float(np.linalg.norm(rel1[:3, 3] - rel0[:3, 3]))
+    touching = [f >= MIN_FINGER_FORCE_N for f in forces.values()]
+    if not any(touching):
+        raise TrialFailed(FailureReason.DROPPED, f"no finger touches the object after the hold (slip {res.slip_m:.3f} m)")
+    if not all(touching) or res.slip_m > scfg.slip_threshold_m:
+        raise TrialFailed(FailureReason.SLIPPED, f"slip {res.slip_m:.4f} m, finger forces {forces} N")
+    sim.phase("done", {"slip_m": res.slip_m})
