@@ -8,7 +8,18 @@ from pathlib import Path
 from graspexp.config import ConfigError, register_configs, validate
 
 CONF_DIR = str(Path(__file__).resolve().parent.parent / "conf")
-_VALUE_FLAGS = {"--cfg", "-c", "--package", "-p", "--config-path", "-cp", "--config-name", "-cn", "--config-dir", "-cd"}
+_VALUE_FLAGS = {
+    "--cfg",
+    "-c",
+    "--package",
+    "-p",
+    "--config-path",
+    "-cp",
+    "--config-name",
+    "-cn",
+    "--config-dir",
+    "-cd",
+}
 
 
 def split_argv(argv: list[str]) -> list[str]:
@@ -30,10 +41,14 @@ def _one_line(exc: BaseException) -> str:
     msg = lines[0] if lines else type(exc).__name__
     for i, ln in enumerate(lines):
         if ln.startswith("Available options"):
-            opts = [o for o in lines[i + 1 :] if not o.startswith(("Config search path", "provider=", "base_"))]
+            opts = [
+                o for o in lines[i + 1 :] if not o.startswith(("Config search path", "provider=", "base_"))
+            ]
             return f"{msg}; {ln.rstrip(':')}: {', '.join(opts)}"
     if len(lines) > 1 and lines[0].startswith(("Could not override", "Error merging override")):
-        detail = next((x for x in lines[1:] if not x.startswith(("To append", "full_key", "object_type"))), "")
+        detail = next(
+            (x for x in lines[1:] if not x.startswith(("To append", "full_key", "object_type"))), ""
+        )
         return f"{msg} {detail}".strip()
     return msg
 

@@ -81,7 +81,9 @@ def _metadata(cfg: DictConfig, object_name: str, trial: int, seed: int) -> dict[
     return meta
 
 
-def _error_result(cfg: DictConfig, object_name: str, trial: int, seed: int, exc: BaseException) -> TrialResult:
+def _error_result(
+    cfg: DictConfig, object_name: str, trial: int, seed: int, exc: BaseException
+) -> TrialResult:
     return TrialResult(
         dataset=cfg.dataset.name,
         object=object_name,
@@ -96,7 +98,9 @@ def _error_result(cfg: DictConfig, object_name: str, trial: int, seed: int, exc:
     )
 
 
-def run_object_trials(cfg: DictConfig, object_name: str, run_dir: Path, bar: tqdm | None = None) -> list[TrialResult]:
+def run_object_trials(
+    cfg: DictConfig, object_name: str, run_dir: Path, bar: tqdm | None = None
+) -> list[TrialResult]:
     """Every trial of one object; finished trials found in ``run_dir`` are read back instead of re-run."""
     plain = plain_config(cfg)
     model = hulls = load_error = None
@@ -146,7 +150,9 @@ def summarize(df: pd.DataFrame) -> pd.DataFrame:
     """Per-object success rate (%) and failure counts, plus an Average row."""
     g = df.groupby("object", sort=False)
     table = pd.DataFrame({"trials": g.size(), "success_%": 100.0 * g["success"].mean()})
-    reasons = df[~df["success"]].pivot_table(index="object", columns="reason", values="trial", aggfunc="count")
+    reasons = df[~df["success"]].pivot_table(
+        index="object", columns="reason", values="trial", aggfunc="count"
+    )
     table = table.join(reasons.fillna(0).astype(int)) if not reasons.empty else table
     table.loc["Average"] = table.mean(numeric_only=True)
     return table.fillna(0)
@@ -161,7 +167,9 @@ def run_job(cfg: DictConfig) -> float:
     objects = select_objects(cfg)
     results: list[TrialResult] = []
     with tqdm(
-        total=len(objects) * cfg.trials, desc=f"{cfg.mode.name}/{cfg.rot.name}/{cfg.dataset.name}", disable=not cfg.progress
+        total=len(objects) * cfg.trials,
+        desc=f"{cfg.mode.name}/{cfg.rot.name}/{cfg.dataset.name}",
+        disable=not cfg.progress,
     ) as bar:
         for name in objects:
             results.extend(run_object_trials(cfg, name, run_dir, bar))
@@ -170,7 +178,8 @@ def run_job(cfg: DictConfig) -> float:
     table = summarize(df)
     text = table.to_markdown(floatfmt=".3g")
     (run_dir / "summary.md").write_text(text + "\n")
-    print(f"\n{cfg.mode.name} / rot {cfg.rot.name} / {cfg.dataset.name} / planner {cfg.planner.name}: {run_dir}")
+    print(
+        f"\n{cfg.mode.name} / rot {cfg.rot.name} / {cfg.dataset.name} / planner {cfg.planner.name}: {run_dir}"
+    )
     print(text)
     return float(df["success"].mean())
-

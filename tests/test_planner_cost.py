@@ -35,7 +35,9 @@ def _hand_eq1() -> float:
 
 def test_eq1_by_hand_on_three_points():
     assert _hand_eq1() == pytest.approx(3.5 / 8.0 * (1.0 + 0.4 + 20.0 / 901.0), rel=1e-15)
-    got = cluster_costs(POINTS_MM / 1000.0, np.zeros(3), R_K_MM / 1000.0, PATH_X, AXIS_60, "collab", -1.0, G_M, COST)
+    got = cluster_costs(
+        POINTS_MM / 1000.0, np.zeros(3), R_K_MM / 1000.0, PATH_X, AXIS_60, "collab", -1.0, G_M, COST
+    )
     assert got.shape == (1,)
     assert got[0] == pytest.approx(_hand_eq1(), rel=1e-6)
 
@@ -49,7 +51,9 @@ def test_eq1_distance_sum_float32_and_float64_agree_with_hand_value():
 
 def test_eq1_is_the_same_for_a_path_and_its_reverse():
     both = np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]])
-    got = cluster_costs(POINTS_MM / 1000.0, np.zeros(3), R_K_MM / 1000.0, both, AXIS_60, "collab", -1.0, G_M, COST)
+    got = cluster_costs(
+        POINTS_MM / 1000.0, np.zeros(3), R_K_MM / 1000.0, both, AXIS_60, "collab", -1.0, G_M, COST
+    )
     assert got[0] == pytest.approx(got[1], rel=1e-12)
 
 
@@ -61,7 +65,9 @@ def test_eq2_eq3_by_hand_near_and_far_from_the_table():
     points_mm = np.stack([20.0 * d + 10.0 * n1, -5.0 * d + 4.0 * n2])  # Y = 10 mm and 4 mm
     axis = np.array([0.0, 1.0, 0.0])  # alpha = 90 deg
     angle = (0.1 * abs(90.0 - 90.0) + 0.5) / 8.0  # 0.0625
-    dist = min(1.0, 20.0 / ((10.0 - 10.0) ** 2 + 1.0)) + min(1.0, 20.0 / ((4.0 - 10.0) ** 2 + 1.0))  # 1 + 20/37
+    dist = min(1.0, 20.0 / ((10.0 - 10.0) ** 2 + 1.0)) + min(
+        1.0, 20.0 / ((4.0 - 10.0) ** 2 + 1.0)
+    )  # 1 + 20/37
     t_near = (math.pi / 6.0 - math.pi / 2.0) ** 2 / 2.0 + 0.05  # d_k = 50 mm <= g = 110 mm
     t_far = 1.0  # d_k = 200 mm > g
 
@@ -83,14 +89,20 @@ def test_eq3_switches_exactly_at_the_gripper_stroke():
 
 def test_angles_are_line_angles_in_their_ranges():
     axis = np.array([0.0, 0.0, 1.0])
-    dirs = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, math.sqrt(0.5), -math.sqrt(0.5)]])
+    dirs = np.array(
+        [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, math.sqrt(0.5), -math.sqrt(0.5)]]
+    )
     np.testing.assert_allclose(path_main_axis_angles_deg(dirs, axis), [0.0, 0.0, 90.0, 45.0], atol=1e-6)
-    np.testing.assert_allclose(path_table_angles_rad(dirs), [math.pi / 2, math.pi / 2, 0.0, math.pi / 4], atol=1e-12)
+    np.testing.assert_allclose(
+        path_table_angles_rad(dirs), [math.pi / 2, math.pi / 2, 0.0, math.pi / 4], atol=1e-12
+    )
 
 
 def test_cost_constants_come_from_the_config():
     doubled = CostConfig(distance_numerator_mm2=40.0, distance_cap=5.0, angle_divisor=4.0)
-    got = cluster_costs(POINTS_MM / 1000.0, np.zeros(3), R_K_MM / 1000.0, PATH_X, AXIS_60, "collab", -1.0, G_M, doubled)
+    got = cluster_costs(
+        POINTS_MM / 1000.0, np.zeros(3), R_K_MM / 1000.0, PATH_X, AXIS_60, "collab", -1.0, G_M, doubled
+    )
     hand = (0.1 * 30.0 + 0.5) / 4.0 * (min(5.0, 40.0) + min(5.0, 40.0 / 50.0) + min(5.0, 40.0 / 901.0))
     assert got[0] == pytest.approx(hand, rel=1e-6)
 

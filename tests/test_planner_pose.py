@@ -7,7 +7,13 @@ import pytest
 from test_planner_common import RG2
 
 from graspexp.planning.paths import fibonacci_sphere
-from graspexp.planning.pose import grasp_pose, grasp_rotation, grasp_rotations, opening_width_m, slab_extents_m
+from graspexp.planning.pose import (
+    grasp_pose,
+    grasp_rotation,
+    grasp_rotations,
+    opening_width_m,
+    slab_extents_m,
+)
 
 
 def _assert_frame(R, approach, axis):

@@ -73,4 +73,6 @@ def validate(cfg: DictConfig) -> None:
             f"gripper.min_width_m={g.min_width_m!r} is invalid: must be below gripper.max_width_m={g.max_width_m!r}"
         )
     if g is not None and len(g.palm_size_m) != 3:
-        raise ConfigError(f"gripper.palm_size_m={list(g.palm_size_m)!r} is invalid: expected [x, y, z] in metres")
+        raise ConfigError(
+            f"gripper.palm_size_m={list(g.palm_size_m)!r} is invalid: expected [x, y, z] in metres"
+        )

@@ -67,6 +67,8 @@ def _load_mesh_cached(path: Path, _mtime_ns: int, scale: float) -> MeshEntry:
         raise DatasetError(f"broken mesh {path}: cannot be loaded ({type(err).__name__}: {err})") from None
     vertices = np.asarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=float)
     faces = np.asarray(getattr(loaded, "faces", np.empty((0, 3))), dtype=np.int64)
+    if not np.all(np.isfinite(vertices)):  # check before merging: processing would drop them silently
+        raise DatasetError(f"broken mesh {path}: it has non-finite vertex coordinates")
     return _validated(trimesh.Trimesh(vertices * scale, faces, process=True), str(path))
 
 
@@ -81,7 +83,8 @@ def _validated(mesh: trimesh.Trimesh, what: str) -> MeshEntry:
     if not np.all(np.isfinite(mesh.vertices)):
         raise DatasetError(f"broken mesh {what}: it has non-finite vertex coordinates")
     try:
-        hull_volume = float(mesh.convex_hull.volume)
+        with np.errstate(divide="ignore", invalid="ignore"):  # trimesh divides by a zero volume
+            hull_volume = float(mesh.convex_hull.volume)
     except Exception:  # qhull fails on flat or collinear input
         hull_volume = 0.0
     if not hull_volume > MIN_VOLUME_M3:
@@ -133,14 +136,15 @@ def load_object(cfg: Any, name: str, n_points: int, seed: int) -> ObjectModel:
     if name not in specs:
         raise DatasetError(f"no grasping-area spec for object {name!r} in {specs_file}; add an entry there")
 
-    mesh = entry.mesh.copy(include_cache=True)
-    points, face_index = trimesh.sample.sample_surface(mesh, int(n_points), seed=int(seed))
-    normals = mesh.face_normals[face_index]
-    mask = area_mask(specs[name], points, mesh.bounds, data_dirs=(dataset_dir(cfg), resolve_root(cfg)))
+    # Sample on the cached mesh (its face areas and normals are computed once); hand out a copy.
+    points, face_index = trimesh.sample.sample_surface(entry.mesh, int(n_points), seed=int(seed))
+    normals = entry.mesh.face_normals[face_index]
+    data_dirs = (dataset_dir(cfg), resolve_root(cfg))
+    mask = area_mask(specs[name], points, entry.mesh.bounds, data_dirs=data_dirs)
     return ObjectModel(
         name=name,
         dataset=cfg.name,
-        mesh=mesh,
+        mesh=entry.mesh.copy(include_cache=False),
         points=np.asarray(points, dtype=np.float64),
         normals=np.asarray(normals, dtype=np.float64),
         area_mask=mask,

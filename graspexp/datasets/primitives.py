@@ -97,7 +97,7 @@ def mug() -> trimesh.Trimesh:
 def banana() -> trimesh.Trimesh:
     """Banana: tube of diameter 35 mm along a 100-degree arc in the xy plane, 180 mm along the arc.
 
-    The arc bulges towards -x; its chord runs along y; the body lies on the table (z from 0 to 35 mm).
+    The middle of the arc bulges towards +x; its chord runs along y; it lies on the table (z 0 to 35 mm).
     """
     radius_m, length_m, arc = 0.035 / 2, 0.180, np.deg2rad(100.0)
     bend_radius = length_m / arc

@@ -44,7 +44,9 @@ def path_table_angles_rad(directions: np.ndarray) -> np.ndarray:
 
 def angle_term(alpha_deg: np.ndarray, cost: CostConfig) -> np.ndarray:
     """First factor of Eq. (1): ``(w |alpha_deg - target_deg| + offset) / divisor``."""
-    return (cost.angle_weight * np.abs(alpha_deg - cost.angle_target_deg) + cost.angle_offset) / cost.angle_divisor
+    return (
+        cost.angle_weight * np.abs(alpha_deg - cost.angle_target_deg) + cost.angle_offset
+    ) / cost.angle_divisor
 
 
 def table_term(d_k_mm: float, beta_rad: np.ndarray, g_mm: float, cost: CostConfig) -> np.ndarray:

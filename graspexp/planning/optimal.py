@@ -84,7 +84,15 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
         ok = feasible[j]
         if ok.any():
             costs[j, ok] = cluster_costs(
-                points, centers[j], radii[j], directions[j, ok], axis, req.mode, req.table_z, gr.max_width_m, req.cost
+                points,
+                centers[j],
+                radii[j],
+                directions[j, ok],
+                axis,
+                req.mode,
+                req.table_z,
+                gr.max_width_m,
+                req.cost,
             )
 
     order = np.argsort(costs, axis=None, kind="stable")[:n_table_ok]

@@ -62,7 +62,11 @@ def sphere_points(centers_m: np.ndarray, directions: np.ndarray, sphere_radius_m
 
 
 def above_support(
-    centers_m: np.ndarray, directions: np.ndarray, sphere_radius_m: float, table_z_m: float, clearance_m: float
+    centers_m: np.ndarray,
+    directions: np.ndarray,
+    sphere_radius_m: float,
+    table_z_m: float,
+    clearance_m: float,
 ) -> np.ndarray:
     """(K, M) bool: True where the path's sphere point is at or above ``z = table_z_m + clearance_m``."""
     start_z = centers_m[:, None, 2] - sphere_radius_m * directions[..., 2]

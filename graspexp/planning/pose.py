@@ -64,7 +64,9 @@ def opening_width_m(r_k_m: float, width_margin: float, gripper: GripperConfig) -
     return float(np.clip(2.0 * r_k_m * (1.0 + width_margin), gripper.min_width_m, gripper.max_width_m))
 
 
-def slab_extents_m(points_m: np.ndarray, center_m: np.ndarray, rotations: np.ndarray, gripper: GripperConfig) -> np.ndarray:
+def slab_extents_m(
+    points_m: np.ndarray, center_m: np.ndarray, rotations: np.ndarray, gripper: GripperConfig
+) -> np.ndarray:
     """Object extent along +Y inside the pads' sweep, for a batch of grasp frames.
 
     points_m : (N, 3) world, metres; center_m : (3,); rotations : (B, 3, 3) grasp rotations.

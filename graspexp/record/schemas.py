@@ -57,8 +57,10 @@ PHASE_NAMES = (
     "close",
     "remove_support",
     "pull_back",
+    "lift",
     "hold",
     "done",
+    "failed",
 )
 """The phase names the trial protocol uses (the Phase schema accepts any string)."""
 

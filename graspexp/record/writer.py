@@ -30,6 +30,10 @@ CHUNK_SIZE_BYTES = 1024 * 1024
 SCENE_SIGNIFICANT_DIGITS = 6
 """Floats in /scene messages are rounded to this many significant digits to keep meshes small."""
 
+CONTACT_SIGNIFICANT_DIGITS = 6
+"""Floats in /contacts messages are rounded to this many significant digits (the bulk of a log).
+/tf, /grasp and /result keep full float64 precision."""
+
 PARTIAL_SUFFIX = ".partial"
 
 
@@ -256,6 +260,8 @@ class TrialWriter:
     def contacts(self, t_s: float, contacts: list[dict]) -> None:
         """/contacts, graspexp.Contacts@1: one message with every contact point of the step.
 
+        Floats are rounded to CONTACT_SIGNIFICANT_DIGITS significant digits.
+
         Each dict: body0, body1 (names), position (3,) world m, normal (3,) world, force_n: (3,) world-frame
         force on body0 in N, or a scalar magnitude along ``normal``; separation_m (float, default 0).
         """
@@ -276,7 +282,8 @@ class TrialWriter:
                     "separation_m": float(c.get("separation_m", 0.0)),
                 }
             )
-        self._write(S.TOPIC_CONTACTS, t_s, to_json_value({"timestamp": stamp(t_s), "contacts": out}))
+        msg = {"timestamp": stamp(t_s), "contacts": to_json_value(out, CONTACT_SIGNIFICANT_DIGITS)}
+        self._write(S.TOPIC_CONTACTS, t_s, msg)
 
     def grasp(self, t_s: float, grasp: Mapping[str, Any]) -> None:
         """/grasp, graspexp.PlannedGrasp@1.

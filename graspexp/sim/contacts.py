@@ -19,8 +19,10 @@ def _touching(contact: sapien.physx.PhysxContact) -> bool:
     return any(np.linalg.norm(p.impulse) > MIN_IMPULSE_NS for p in contact.points)
 
 
-def finger_forces(contacts: list, dt: float) -> dict[str, float]:
-    """|total contact force| between the object and each finger over the last step, N."""
+def finger_forces(contacts: list, dt: float, closing_axis: np.ndarray) -> dict[str, float]:
+    """Squeezing force of each finger on the object over the last step, N: the magnitude of the
+    finger-object contact force along the closing axis ((3,) unit, world). A finger resting on the
+    object's top, with its force along the approach, does not squeeze it."""
     out = dict.fromkeys(FINGER_NAMES, 0.0)
     for c in contacts:
         a, b = _pair_names(c)
@@ -28,7 +30,7 @@ def finger_forces(contacts: list, dt: float) -> dict[str, float]:
             other = b if a == OBJECT_NAME else a
             if other in out:
                 impulse = np.sum([p.impulse for p in c.points], axis=0)
-                out[other] += float(np.linalg.norm(impulse)) / dt
+                out[other] += abs(float(impulse @ closing_axis)) / dt
     return out
 
 

@@ -53,7 +53,7 @@ class Gripper:
 
     def drive_arm(self, offset: np.ndarray) -> None:
         """Position targets of the x, y, z joints: TCP offset in the grasp frame, metres."""
-        for joint, value in zip(self.joints[:3], offset):
+        for joint, value in zip(self.joints[:3], offset, strict=True):
             joint.set_drive_target(float(value))
 
     def drive_fingers(self, half_width_m: float) -> None:
@@ -74,7 +74,9 @@ class Gripper:
         return self.palm.entity_pose.to_transformation_matrix()
 
 
-def build_gripper(scene: sapien.Scene, cfg: GripperConfig, grasp_pose: np.ndarray, support_collides: bool) -> Gripper:
+def build_gripper(
+    scene: sapien.Scene, cfg: GripperConfig, grasp_pose: np.ndarray, support_collides: bool
+) -> Gripper:
     """Build the gripper with its root at ``grasp_pose`` ((4,4) world); fingers open to the stroke."""
     ab = scene.create_articulation_builder()
     pad = sapien.physx.PhysxMaterial(cfg.pad_friction, cfg.pad_friction, 0.0)
@@ -93,7 +95,9 @@ def build_gripper(scene: sapien.Scene, cfg: GripperConfig, grasp_pose: np.ndarra
     L = float(cfg.finger_length_m)
     root_z = -0.75 * L  # finger roots (palm face) sit 3/4 of a finger behind the TCP
     px, py, pz = cfg.palm_size_m
-    palm.add_box_collision(sapien.Pose([0.0, 0.0, root_z - pz / 2]), half_size=[px / 2, py / 2, pz / 2], material=pad)
+    palm.add_box_collision(
+        sapien.Pose([0.0, 0.0, root_z - pz / 2]), half_size=[px / 2, py / 2, pz / 2], material=pad
+    )
     for name, axis, sign in (("finger_left", "y", 1.0), ("finger_right", "-y", -1.0)):
         f = ab.create_link_builder(palm)
         f.set_name(name)
@@ -103,7 +107,10 @@ def build_gripper(scene: sapien.Scene, cfg: GripperConfig, grasp_pose: np.ndarra
         t = float(cfg.finger_thickness_m)
         center = [0.0, sign * t / 2, root_z + L / 2]
         f.add_box_collision(
-            sapien.Pose(center), half_size=[cfg.finger_width_m / 2, t / 2, L / 2], material=pad, density=1000.0
+            sapien.Pose(center),
+            half_size=[cfg.finger_width_m / 2, t / 2, L / 2],
+            material=pad,
+            density=1000.0,
         )
         f.set_mass_and_inertia(cfg.finger_mass_kg, sapien.Pose(center), [1e-5] * 3)
     art = ab.build(fix_root_link=True)
@@ -117,7 +124,9 @@ def build_gripper(scene: sapien.Scene, cfg: GripperConfig, grasp_pose: np.ndarra
     for j in joints[:3]:
         j.set_drive_properties(stiffness=ARM_STIFFNESS, damping=ARM_DAMPING, force_limit=ARM_FORCE_N)
     for j in joints[3:]:
-        j.set_drive_properties(stiffness=FINGER_STIFFNESS, damping=FINGER_DAMPING, force_limit=float(cfg.grip_force_n))
+        j.set_drive_properties(
+            stiffness=FINGER_STIFFNESS, damping=FINGER_DAMPING, force_limit=float(cfg.grip_force_n)
+        )
     links = {lk.name: lk for lk in art.links}
     # couple the fingers like a real parallel gripper's linkage: q_left - q_right -> 0, stiffly
     art.create_fixed_tendon(

@@ -30,7 +30,9 @@ def configure_physx(cfg: SimConfig) -> None:
         solver_velocity_iterations=int(cfg.solver_velocity_iterations),
         sleep_threshold=0.0,
     )
-    sapien.physx.set_shape_config(contact_offset=float(cfg.contact_offset_m), rest_offset=float(cfg.rest_offset_m))
+    sapien.physx.set_shape_config(
+        contact_offset=float(cfg.contact_offset_m), rest_offset=float(cfg.rest_offset_m)
+    )
 
 
 def set_groups(component: sapien.physx.PhysxRigidBaseComponent, member: int, collides_with: int) -> None:
@@ -87,16 +89,22 @@ def build_scene(
     builder.set_initial_pose(sapien.Pose([0.0, 0.0, h / 2]))
     support = builder.build_static(SUPPORT_NAME)
     support_mask = OBJECT_BIT | (GRIPPER_BIT if mode.support_collides_with_gripper else 0)
-    set_groups(support.find_component_by_type(sapien.physx.PhysxRigidStaticComponent), SUPPORT_BIT, support_mask)
+    set_groups(
+        support.find_component_by_type(sapien.physx.PhysxRigidStaticComponent), SUPPORT_BIT, support_mask
+    )
 
     obj_mat = sapien.physx.PhysxMaterial(sim.object_static_friction, sim.object_dynamic_friction, 0.0)
     body = sapien.physx.PhysxRigidDynamicComponent()
     for verts in hulls:
-        shape = sapien.physx.PhysxCollisionShapeConvexMesh(vertices=verts, scale=[1.0, 1.0, 1.0], material=obj_mat)
+        shape = sapien.physx.PhysxCollisionShapeConvexMesh(
+            vertices=verts, scale=[1.0, 1.0, 1.0], material=obj_mat
+        )
         shape.set_density(1000.0)
         body.attach(shape)
     if len(body.get_collision_shapes()) != len(hulls):
-        raise RuntimeError(f"PhysX dropped {len(hulls) - len(body.get_collision_shapes())} of {len(hulls)} hulls")
+        raise RuntimeError(
+            f"PhysX dropped {len(hulls) - len(body.get_collision_shapes())} of {len(hulls)} hulls"
+        )
     entity = sapien.Entity()
     entity.name = OBJECT_NAME
     entity.add_component(body)

@@ -11,7 +11,6 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from graspexp.config import JobConfig
-
 from graspexp.datasets.model import ObjectModel
 from graspexp.geometry import axis_angle_matrix, make_pose, random_rotation, transform_points, yaw_rotation
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
@@ -55,7 +54,7 @@ class TrialContext:
     recorder: object = field(default_factory=NullRecorder)
 
 
-def plain_config(cfg: JobConfig) -> JobConfig:
+def plain_config(cfg: DictConfig) -> JobConfig:
     """The composed job config as dataclass instances (attribute access in the step loop must be cheap)."""
     return OmegaConf.to_object(cfg)
 
@@ -65,7 +64,9 @@ def trial_seed(cfg: JobConfig, object_name: str, trial: int) -> int:
     return derive_seed(cfg.seed, cfg.dataset.name, object_name, trial)
 
 
-def drop_pose(model: ObjectModel, rot: str, table_z: float, gap_m: float, rng: np.random.Generator) -> np.ndarray:
+def drop_pose(
+    model: ObjectModel, rot: str, table_z: float, gap_m: float, rng: np.random.Generator
+) -> np.ndarray:
     """(4,4) world pose at release: rotated (about Z for ``z``, uniformly for ``xyz``), centred over the
     support, lowest point ``gap_m`` above the support plane."""
     R = yaw_rotation(rng.uniform(0.0, 2.0 * np.pi)) if rot == "z" else random_rotation(rng)
@@ -75,7 +76,9 @@ def drop_pose(model: ObjectModel, rot: str, table_z: float, gap_m: float, rng: n
     return make_pose(R, t)
 
 
-def perceived_pose(true_pose: np.ndarray, trans_mm: float, rot_deg: float, rng: np.random.Generator) -> np.ndarray:
+def perceived_pose(
+    true_pose: np.ndarray, trans_mm: float, rot_deg: float, rng: np.random.Generator
+) -> np.ndarray:
     """The pose the planner sees: Gaussian translation (std ``trans_mm``) and a rotation about a random axis
     by a Gaussian angle (std ``rot_deg``) about the object's origin. Zero noise returns the pose unchanged."""
     if trans_mm == 0 and rot_deg == 0:
@@ -116,7 +119,9 @@ class _Sim:
         if self.watch_support and gripper_touches_support(self.ts.scene.get_contacts()):
             self.touched_support = True
             self.log()
-            raise TrialFailed(FailureReason.COLLISION_SUPPORT, f"gripper touched the support at t={self.t:.3f} s")
+            raise TrialFailed(
+                FailureReason.COLLISION_SUPPORT, f"gripper touched the support at t={self.t:.3f} s"
+            )
         if self.steps % self.log_every == 0:
             self.log()
 
@@ -125,7 +130,9 @@ class _Sim:
         v, w = body.linear_velocity, body.angular_velocity
         vv, ww = float(v @ v), float(w @ w)
         if not (vv <= self.max_speed_sq and ww < 1e12):  # NaN fails every comparison
-            raise TrialFailed(FailureReason.SIM_UNSTABLE, f"object speed {vv**0.5:.3g} m/s at t={self.t:.3f} s")
+            raise TrialFailed(
+                FailureReason.SIM_UNSTABLE, f"object speed {vv**0.5:.3g} m/s at t={self.t:.3f} s"
+            )
 
     def frames(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """World poses (position, quaternion wxyz) of the logged frames."""
@@ -186,7 +193,11 @@ def _scene_entities(ctx: TrialContext, table_z: float) -> list[dict]:
 
     mode = ctx.cfg.mode
     hx, hy = mode.support_half_size_m
-    ents = [box_entity("support", "world", [0.0, 0.0, table_z / 2], [2 * hx, 2 * hy, table_z], [0.6, 0.45, 0.3, 1.0])]
+    ents = [
+        box_entity(
+            "support", "world", [0.0, 0.0, table_z / 2], [2 * hx, 2 * hy, table_z], [0.6, 0.45, 0.3, 1.0]
+        )
+    ]
     for i, m in enumerate(hull_meshes(ctx.hulls)):
         ents.append(mesh_entity(f"object_hull_{i}", "object", m.vertices, m.faces, [0.2, 0.4, 0.9, 1.0]))
     return ents
@@ -201,8 +212,10 @@ def _gripper_entities(cfg: JobConfig) -> list[dict]:
     px, py, pz = g.palm_size_m
     grey = [0.5, 0.5, 0.5, 1.0]
     ents = [box_entity("palm", "palm", [0.0, 0.0, root_z - pz / 2], [px, py, pz], grey)]
-    for name, sign in zip(FINGER_NAMES, (1.0, -1.0)):
-        ents.append(box_entity(name, name, [0.0, sign * t / 2, root_z + L / 2], [g.finger_width_m, t, L], grey))
+    for name, sign in zip(FINGER_NAMES, (1.0, -1.0), strict=True):
+        ents.append(
+            box_entity(name, name, [0.0, sign * t / 2, root_z + L / 2], [g.finger_width_m, t, L], grey)
+        )
     return ents
 
 
@@ -279,9 +292,10 @@ def _drop_until_on_support(ctx: TrialContext, res: TrialResult, timings: dict) -
 
 def _plan(ctx: TrialContext, sim: _Sim) -> Grasp:
     cfg = ctx.cfg
-    t0 = time.perf_counter()
     noise = cfg.perception.noise
-    seen = perceived_pose(sim.ts.object_pose(), noise.trans_mm, noise.rot_deg, rng_for(ctx.trial_seed, "noise"))
+    seen = perceived_pose(
+        sim.ts.object_pose(), noise.trans_mm, noise.rot_deg, rng_for(ctx.trial_seed, "noise")
+    )
     req = PlanRequest(
         points=transform_points(seen, ctx.model.points),
         normals=ctx.model.normals @ seen[:3, :3].T,
@@ -298,13 +312,13 @@ def _plan(ctx: TrialContext, sim: _Sim) -> Grasp:
         grasp = plan(req).grasp
     except NoFeasibleGrasp as e:
         raise TrialFailed(FailureReason.NO_FEASIBLE_GRASP, str(e)) from None
-    sim.phase("plan", {"plan_ms": 1e3 * (time.perf_counter() - t0)})
+    sim.phase("plan")
     ctx.recorder.grasp(sim.t, _grasp_record(grasp))
     return grasp
 
 
-def _held(sim: _Sim) -> dict[str, float]:
-    return finger_forces(sim.ts.scene.get_contacts(), sim.dt)
+def _held(sim: _Sim, grasp: Grasp) -> dict[str, float]:
+    return finger_forces(sim.ts.scene.get_contacts(), sim.dt, grasp.pose[:3, 1])
 
 
 def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> None:
@@ -320,11 +334,14 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
     gripper.set_state(np.array([0.0, 0.0, -standoff]), half)
 
     sim.phase("approach", {"standoff_m": standoff, "width_m": grasp.width_m})
-    sim.run(standoff / scfg.approach_speed_mps, lambda s: gripper.drive_arm(np.array([0.0, 0.0, -standoff * (1 - s)])))
+    sim.run(
+        standoff / scfg.approach_speed_mps,
+        lambda s: gripper.drive_arm(np.array([0.0, 0.0, -standoff * (1 - s)])),
+    )
     sim.phase("close")
     gripper.close()
     sim.run(scfg.close_s)
-    forces = _held(sim)
+    forces = _held(sim, grasp)
     if min(forces.values()) < MIN_FINGER_FORCE_N:
         res.finger_force_n = [forces[n] for n in FINGER_NAMES]
         raise TrialFailed(FailureReason.NO_CONTACT, f"finger forces after closing {forces} N")
@@ -335,7 +352,10 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
         ts.remove_support()
     if mode.pull_back_m > 0:
         sim.phase("pull_back", {"distance_m": mode.pull_back_m})
-        sim.run(mode.pull_back_m / scfg.retract_speed_mps, lambda s: gripper.drive_arm(np.array([0, 0, -mode.pull_back_m * s])))
+        sim.run(
+            mode.pull_back_m / scfg.retract_speed_mps,
+            lambda s: gripper.drive_arm(np.array([0, 0, -mode.pull_back_m * s])),
+        )
     if mode.lift_m > 0:
         sim.phase("lift", {"distance_m": mode.lift_m})
         start = np.array([0.0, 0.0, -mode.pull_back_m])
@@ -343,13 +363,15 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
         sim.run(mode.lift_m / scfg.retract_speed_mps, lambda s: gripper.drive_arm(start + s * up))
     sim.phase("hold", {"duration_s": mode.hold_s})
     sim.run(mode.hold_s)
-    forces = _held(sim)
+    forces = _held(sim, grasp)
     res.finger_force_n = [forces[n] for n in FINGER_NAMES]
     rel1 = np.linalg.inv(gripper.tcp_pose()) @ ts.object_pose()
     res.slip_m = float(np.linalg.norm(rel1[:3, 3] - rel0[:3, 3]))
     touching = [f >= MIN_FINGER_FORCE_N for f in forces.values()]
     if not any(touching):
-        raise TrialFailed(FailureReason.DROPPED, f"no finger touches the object after the hold (slip {res.slip_m:.3f} m)")
+        raise TrialFailed(
+            FailureReason.DROPPED, f"no finger touches the object after the hold (slip {res.slip_m:.3f} m)"
+        )
     if not all(touching) or res.slip_m > scfg.slip_threshold_m:
         raise TrialFailed(FailureReason.SLIPPED, f"slip {res.slip_m:.4f} m, finger forces {forces} N")
     sim.phase("done", {"slip_m": res.slip_m})

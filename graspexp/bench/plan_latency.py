@@ -1,0 +1,100 @@
+"""Planner latency per paper Table 1 YCB object, single-threaded (paper IV-F reports 0.1 s per plan).
+
+Usage::
+
+    GRASPEXP_DATA=/path/to/datasets python -m graspexp.bench.plan_latency [--repeats 5] [--runs 30] [override ...]
+
+Each object stands upright on the support as in :mod:`graspexp.plan` (N = ``planner.n_points``, default
+2048; M = ``planner.m``, default 256), in each mode. One repeat times ``--runs`` plans after a warm-up
+and takes their p50 and p95; the table shows the median over repeats of each. BLAS/OpenMP run on one
+thread (``OMP_NUM_THREADS=1`` and friends set before numpy loads, and threadpoolctl). ``vs paper`` is
+p50 / 100 ms. Without the YCB meshes under the data root it falls back to the procedural
+``primitives`` dataset and says so. Extra ``key=value`` arguments are Hydra overrides.
+"""
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import argparse  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from collections.abc import Sequence  # noqa: E402
+
+import numpy as np  # noqa: E402
+from threadpoolctl import threadpool_limits  # noqa: E402
+
+from graspexp.plan import CliError, compose, load, upright_request  # noqa: E402
+from graspexp.planning import plan  # noqa: E402
+
+PAPER_PLAN_S = 0.1
+"""The paper's planner time (clusters + paths + cost), seconds (IV-F, i7-9700)."""
+MODES = ("collab", "bin")
+WARMUP_RUNS = 3
+
+
+def time_plans(req, runs: int, repeats: int) -> tuple[float, float]:
+    """Median over ``repeats`` of the p50 and of the p95 of ``runs`` plan times, ms."""
+    for _ in range(WARMUP_RUNS):
+        plan(req)
+    p50s, p95s = [], []
+    for _ in range(repeats):
+        times = np.empty(runs)
+        for i in range(runs):
+            start = time.perf_counter()
+            plan(req)
+            times[i] = time.perf_counter() - start
+        p50s.append(np.percentile(times, 50) * 1e3)
+        p95s.append(np.percentile(times, 95) * 1e3)
+    return float(np.median(p50s)), float(np.median(p95s))
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m graspexp.bench.plan_latency", description=__doc__.split("\n")[0]
+    )
+    parser.add_argument("--repeats", type=int, default=5, help="repeats per object and mode (median taken)")
+    parser.add_argument("--runs", type=int, default=30, help="timed plans per repeat")
+    args, overrides = parser.parse_known_args(sys.argv[1:] if argv is None else argv)
+    try:
+        cfg = compose(["dataset=ycb", *overrides])
+        dataset = str(cfg.dataset.name)
+        names = list(cfg.dataset.objects)
+        try:
+            load(cfg, names[0])
+        except CliError as err:
+            print(f"note: {dataset} meshes unavailable ({err}); falling back to the primitives dataset")
+            cfg = compose([*overrides, "dataset=primitives"])
+            dataset, names = "primitives", list(cfg.dataset.objects)
+        print(
+            f"plan latency, {dataset}, N={cfg.planner.n_points} M={cfg.planner.m} gripper={cfg.gripper.name}, "
+            f"1 thread, {args.repeats} repeats x {args.runs} runs (median of per-repeat p50/p95)"
+        )
+        print(f"{'object':<26}{'mode':<8}{'K':>3}{'area':>6}{'p50 ms':>9}{'p95 ms':>9}{'vs paper':>10}")
+        all_p50 = []
+        with threadpool_limits(limits=1):
+            for name in names:
+                model = load(cfg, name)
+                for mode in MODES:
+                    cfg.mode.name = mode
+                    req = upright_request(cfg, model)
+                    k = plan(req).grasp.extras["K"]
+                    p50, p95 = time_plans(req, args.runs, args.repeats)
+                    all_p50.append(p50)
+                    ratio = p50 / (PAPER_PLAN_S * 1e3)
+                    print(
+                        f"{name:<26}{mode:<8}{k:>3}{int(model.area_mask.sum()):>6}{p50:>9.2f}{p95:>9.2f}{ratio:>10.3f}"
+                    )
+    except CliError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    overall = float(np.median(all_p50))
+    print(
+        f"median p50 over objects and modes: {overall:.2f} ms = {overall / (PAPER_PLAN_S * 1e3):.3f} x the paper's 0.1 s"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,138 @@
+"""Assemble the report from a run or multirun directory and write it as Markdown, CSV, LaTeX and PNG.
+
+Output files (in ``<dir>/report/`` unless told otherwise)::
+
+    report.md                        everything below, in one Markdown file (also printed)
+    table<N>_<dataset>_<planner>.*   success table: .md / .tex (paper layout), .csv (numeric), .png
+    failures.{md,csv,tex}            failure-reason counts per setting
+    runtime.{md,csv,tex}             planner wall time p50 / p95 against the paper's 0.1 s
+    unreadable.csv                   logs that could not be read (path, reason), if any
+"""
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from graspexp.report.collect import Collected, collect
+from graspexp.report.figures import success_chart
+from graspexp.report.paper import PLANNER_RUNTIME_S
+from graspexp.report.render import display_frame, fmt_pct, footnotes, latex, markdown
+from graspexp.report.tables import (
+    SuccessTable,
+    failure_breakdown,
+    runtime_table,
+    success_tables,
+    wide_numeric,
+)
+
+
+@dataclass
+class Report:
+    collected: Collected
+    tables: list[SuccessTable]
+    failures: pd.DataFrame
+    runtime: pd.DataFrame
+
+
+def build_report(root: Path | str) -> Report:
+    """Collect every trial log below ``root`` and build all tables (nothing is written)."""
+    col = collect(root)
+    df = col.results
+    if df.empty:
+        return Report(col, [], pd.DataFrame(), pd.DataFrame())
+    return Report(col, success_tables(df), failure_breakdown(df), runtime_table(df))
+
+
+def _runtime_display(rt: pd.DataFrame) -> pd.DataFrame:
+    out = rt.copy()
+    for c in ("p50_ms", "p95_ms"):
+        out[c] = [fmt_pct(v, 1) for v in out[c]]
+    out["paper_ms"] = [fmt_pct(v, 0) for v in out["paper_ms"]]
+    for c in ("p50_ratio", "p95_ratio"):
+        out[c] = [fmt_pct(v, 2) + "×" if v == v else "n/a" for v in out[c]]
+    return out.rename(
+        columns={
+            "p50_ms": "plan p50 (ms)",
+            "p95_ms": "plan p95 (ms)",
+            "paper_ms": "paper (ms)",
+            "p50_ratio": "p50 / paper",
+            "p95_ratio": "p95 / paper",
+        }
+    )
+
+
+def _unreadable_section(col: Collected) -> list[str]:
+    lines = [f"## Unreadable logs ({len(col.unreadable)})", ""]
+    if not col.unreadable:
+        return [*lines, "None: every trial log below the directory was read.", ""]
+    lines.append(
+        "These logs could not be read and are NOT counted in the tables above; re-run the same "
+        "command into the same directory to redo those trials."
+    )
+    lines.append("")
+    lines += [f"- `{p}`: {reason}" for p, reason in col.unreadable]
+    return [*lines, ""]
+
+
+def write_report(report: Report, out_dir: Path | str) -> str:
+    """Write every file of the report into ``out_dir``; returns the Markdown of report.md."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    col = report.collected
+    n_logs = len(col.results) + len(col.unreadable) + len(col.duplicates)
+    md = [
+        f"# graspexp report: {col.root}",
+        "",
+        f"{n_logs} trial logs found, {len(col.results)} results read.",
+        "",
+    ]
+    for table in report.tables:
+        disp = display_frame(table)
+        title = table.paper.title if table.paper else f"Grasping success rate on {table.dataset}"
+        title = f"{title}, planner {table.planner}"
+        (out / f"{table.name}.md").write_text(markdown(disp) + "\n")
+        (out / f"{table.name}.tex").write_text(latex(disp, caption=title))
+        wide_numeric(table).to_csv(out / f"{table.name}.csv")
+        success_chart(table, out / f"{table.name}.png")
+        md += [f"## {title}", "", markdown(disp), ""]
+        md += [f"{i}. {note}" for i, note in enumerate(footnotes(table), 1)]
+        md += ["", f"![{table.name}]({table.name}.png)", ""]
+    if not report.failures.empty:
+        (out / "failures.md").write_text(markdown(report.failures, index=False) + "\n")
+        (out / "failures.tex").write_text(latex(report.failures, "Failure reasons per setting", index=False))
+        report.failures.to_csv(out / "failures.csv", index=False)
+        md += [
+            "## Failure reasons per setting (trial counts)",
+            "",
+            markdown(report.failures, index=False),
+            "",
+        ]
+    if not report.runtime.empty:
+        disp = _runtime_display(report.runtime)
+        (out / "runtime.md").write_text(markdown(disp, index=False) + "\n")
+        (out / "runtime.tex").write_text(latex(disp, "Planner wall time", index=False))
+        report.runtime.to_csv(out / "runtime.csv", index=False)
+        md += [
+            "## Planner runtime",
+            "",
+            markdown(disp, index=False),
+            "",
+            f"Wall time of the planning phase per trial (TrialResult timings_s.plan) on this machine; the "
+            f"paper (section IV-F) reports {PLANNER_RUNTIME_S:g} s for the grasping strategy on an i7-9700.",
+            "",
+        ]
+    md += _unreadable_section(col)
+    if col.unreadable:
+        pd.DataFrame(col.unreadable, columns=["path", "reason"]).to_csv(out / "unreadable.csv", index=False)
+    if col.duplicates:
+        md += [
+            f"## Duplicate trials ({len(col.duplicates)})",
+            "",
+            "Logged twice below the directory; the first log is counted, these are not:",
+            "",
+        ]
+        md += [f"- `{p}` (same trial as `{kept}`)" for p, kept in col.duplicates] + [""]
+    text = "\n".join(md)
+    (out / "report.md").write_text(text)
+    return text

@@ -1,0 +1,117 @@
+"""The planner on every real mesh of the shared data root (skipped without it), plus its CLIs."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from test_planner_common import RG2
+
+from graspexp.config import CostConfig, DatasetConfig, PlannerConfig
+from graspexp.datasets import load_object
+from graspexp.datasets.catalog import candidate_paths, dataset_spec
+from graspexp.planning import PlanRequest, plan
+from graspexp.plan import main as plan_main
+from graspexp.plan import split_args, upright_pose
+
+
+def _present(root, dataset):
+    cfg = DatasetConfig(name=dataset, root=str(root), regions=f"{dataset}.yaml")
+    return cfg, [n for n in dataset_spec(dataset).catalogue if any(p.is_file() for p in candidate_paths(cfg, n))]
+
+
+@pytest.mark.parametrize("dataset", ["ycb", "linemod"])
+def test_plan_every_real_object_in_both_modes(data_root, dataset):
+    cfg, names = _present(data_root, dataset)
+    if not names:
+        pytest.skip(f"no {dataset} mesh under {data_root}")
+    support_z = 0.1
+    for name in names:
+        model = load_object(cfg, name, 2048, 0)
+        pose = upright_pose(model, support_z)
+        pts = model.points + pose[:3, 3]
+        assert pts[:, 2].min() >= support_z - 1e-9
+        for mode in ("collab", "bin"):
+            req = PlanRequest(
+                points=pts,
+                normals=model.normals,
+                area_mask=model.area_mask,
+                object_pose=pose,
+                table_z=support_z,
+                mode=mode,
+                gripper=RG2,
+                planner=PlannerConfig(name="optimal"),
+                cost=CostConfig(),
+                seed=1,
+            )
+            res = plan(req)
+            g, det = res.grasp, res.details
+            R = g.pose[:3, :3]
+            np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-9, err_msg=f"{name} {mode}")
+            assert np.linalg.det(R) == pytest.approx(1.0, abs=1e-9)
+            assert np.isfinite(g.cost) and g.n_feasible > 0, (name, mode)
+            start = g.position - 0.1 * g.approach
+            assert start[2] >= support_z, (name, mode)
+            assert RG2.min_width_m <= g.width_m <= RG2.max_width_m
+            assert det["area_mask"].sum() > 0
+            # The grasp point is the centre of a cluster of area points, so it is near the area.
+            area = pts[model.area_mask]
+            assert np.min(np.linalg.norm(area - g.position, axis=1)) < 0.06, (name, mode)
+
+
+def test_split_args_takes_object_and_dump_out_of_the_hydra_overrides():
+    found, rest = split_args(["dataset=ycb", "object=025_mug", "+dump=a.npz", "mode=bin", "objects=[x]"], ("object", "dump"))
+    assert found == {"object": "025_mug", "dump": "a.npz"}
+    assert rest == ["dataset=ycb", "mode=bin", "objects=[x]"]
+
+
+def test_plan_cli_prints_one_json_object_and_dumps(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    dump = tmp_path / "mug.npz"
+    assert plan_main(["dataset=primitives", "object=mug", "mode=bin", f"+dump={dump}"]) == 0
+    out = capsys.readouterr().out.strip().splitlines()
+    assert len(out) == 1
+    rec = json.loads(out[0])
+    assert {"pose", "width", "cost", "cluster", "path", "object", "n_feasible", "plan_ms"} <= set(rec)
+    assert rec["object"] == "mug" and rec["mode"] == "bin"
+    pose = np.array(rec["pose"])
+    assert pose.shape == (4, 4) and np.linalg.det(pose[:3, :3]) == pytest.approx(1.0)
+    with np.load(dump) as d:
+        for key in ("cloud", "area_mask", "centers", "radii", "main_axis", "directions", "feasible", "costs"):
+            assert key in d.files
+        assert d["costs"].shape == d["feasible"].shape == d["directions"].shape[:2]
+        np.testing.assert_allclose(d["pose"], pose)
+        assert str(d["mode"]) == "bin"
+    # The object rests on the support: the cloud's lowest point is at (or just above) z = support.
+    assert not list(tmp_path.glob("outputs"))  # compose API: no Hydra run folder
+
+
+def test_plan_cli_unknown_object_is_one_line_and_non_zero():
+    proc = subprocess.run(
+        [sys.executable, "-m", "graspexp.plan", "dataset=primitives", "object=teapot"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode != 0
+    assert proc.stdout == ""
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "teapot" in lines[0] and "Traceback" not in proc.stderr
+
+
+def test_figures_cli_writes_the_pngs(tmp_path):
+    from graspexp.figures import main as figures_main
+
+    assert figures_main(["dataset=primitives", "object=mug", f"out={tmp_path}"]) == 0
+    names = sorted(p.name for p in tmp_path.glob("*.png"))
+    assert names == [
+        "fig03_cloud.png",
+        "fig04_area.png",
+        "fig05_clusters.png",
+        "fig06_paths.png",
+        "fig07_main_axis.png",
+        "fig08_removed_paths.png",
+        "fig09_grasp_pose.png",
+    ]
+    assert all((tmp_path / n).stat().st_size > 10_000 for n in names)
