@@ -5,6 +5,8 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from omegaconf import DictConfig
+
 from graspexp.config import ConfigError, register_configs, validate
 
 CONF_DIR = str(Path(__file__).resolve().parent.parent / "conf")
@@ -51,6 +53,20 @@ def _one_line(exc: BaseException) -> str:
         )
         return f"{msg} {detail}".strip()
     return msg
+
+
+def compose_config(overrides: list[str], config_name: str = "config") -> DictConfig:
+    """The job config composed from ``conf/`` with Hydra overrides, outside any Hydra run."""
+    from hydra import compose, initialize_config_dir
+    from hydra.core.global_hydra import GlobalHydra
+
+    register_configs()
+    GlobalHydra.instance().clear()
+    try:
+        with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
+            return compose(config_name, overrides=list(overrides))
+    finally:
+        GlobalHydra.instance().clear()
 
 
 def check_overrides(overrides: list[str], config_name: str = "config") -> None:

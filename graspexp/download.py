@@ -110,6 +110,8 @@ def fetch(url: str, folder: Path, fname: str, sha256: str | None, *, progress: b
         ) from None
     except OSError as err:  # requests' errors derive from OSError (IOError)
         raise DatasetError(f"download of {url} failed: {err}") from None
+    finally:
+        pooch_log.setLevel(level)
     return Path(path)
 
 
@@ -146,7 +148,9 @@ def download_ycb(
     root = Path(root).expanduser()
     for name in objects:
         if name not in YCB_MASS_KG:
-            raise DatasetError(f"unknown object {name!r} in dataset 'ycb'; valid names: {', '.join(YCB_MASS_KG)}")
+            raise DatasetError(
+                f"unknown object {name!r} in dataset 'ycb'; valid names: {', '.join(YCB_MASS_KG)}"
+            )
     archives, dest = root / ARCHIVE_DIR, root / "ycb"
     dest.mkdir(parents=True, exist_ok=True)
     registry = _read_registry(root)
@@ -217,10 +221,12 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
         description="Download and verify YCB (google_16k) or BOP LINEMOD object meshes.",
     )
     parser.add_argument("overrides", nargs="*", help=f"key=value with key in {', '.join(_KEYS)}")
-    parser.add_argument("--base-url", default=None, help="base URL of the archives (default: env or official)")
+    parser.add_argument(
+        "--base-url", default=None, help="base URL of the archives (default: env or official)"
+    )
     parser.add_argument("--sha256", default=None, help="expected SHA-256 of lm_models.zip (mirrors)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
-    args = parser.parse_args(argv)
+    args = parser.parse_intermixed_args(argv)
     values: dict[str, str] = {}
     for item in args.overrides:
         key, sep, value = item.partition("=")
@@ -236,9 +242,15 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
         parser.error(f"dataset={args.dataset!r} cannot be downloaded; valid: {', '.join(valid)}")
     args.root = resolve_root(SimpleNamespace(root=values.get("dataset.root")))
     objects = _parse_list(values["objects"]) if "objects" in values else []
+    args.objects_given = bool(objects)
     if objects == ["all"]:
         objects = list(dataset_spec(args.dataset).catalogue)
     args.objects = objects or list(dataset_spec(args.dataset).default_objects)
+    unknown = [n for n in args.objects if n not in dataset_spec(args.dataset).catalogue]
+    if unknown:
+        parser.error(
+            f"unknown {args.dataset} objects {unknown}; valid: {', '.join(dataset_spec(args.dataset).catalogue)}"
+        )
     return args
 
 
@@ -255,8 +267,12 @@ def main(argv: Sequence[str] | None = None) -> int:
             )
             have = {p.name for p in paths}
             missing = [n for n in args.objects if f"obj_{LINEMOD_IDS[n]:06d}.ply" not in have]
+            if missing and args.objects_given:
+                raise DatasetError(f"{LINEMOD_ARCHIVE} lacks the models of: {', '.join(missing)}")
             if missing:
-                raise DatasetError(f"lm_models.zip lacks the models of: {', '.join(missing)}")
+                print(
+                    f"warning: {LINEMOD_ARCHIVE} lacks the models of: {', '.join(missing)}", file=sys.stderr
+                )
     except DatasetError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2

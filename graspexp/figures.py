@@ -41,8 +41,8 @@ FIG_SIZE_IN = (5.5, 5.5)
 DPI = 130
 
 
-def _axes(fig, spec=111, title=""):
-    ax = fig.add_subplot(spec, projection="3d")
+def _axes(fig, spec=(1, 1, 1), title=""):
+    ax = fig.add_subplot(*spec, projection="3d")
     ax.set_title(title, fontsize=9)
     ax.set_xlabel("x (m)", fontsize=7)
     ax.set_ylabel("y (m)", fontsize=7)

@@ -25,7 +25,7 @@ from graspexp.record import CorruptLogError, TrialRecorder, read_result
 from graspexp.seeding import derive_seed
 from graspexp.sim.collision import convex_hulls
 from graspexp.sim.outcome import FailureReason, TrialResult
-from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
+from graspexp.sim.trial import TrialContext, plain_config, run_trial, scene_entities, trial_seed
 
 log = logging.getLogger(__name__)
 PACKAGES = ("graspexp", "sapien", "numpy", "scikit-learn", "trimesh", "coacd", "mcap", "hydra-core")
@@ -69,16 +69,15 @@ def trial_log_path(run_dir: Path, object_name: str, trial: int) -> Path:
     return run_dir / "trials" / object_name / f"{trial:03d}.mcap"
 
 
-def _metadata(cfg: DictConfig, object_name: str, trial: int, seed: int) -> dict[str, str]:
-    meta = {
-        "config_yaml": OmegaConf.to_yaml(cfg, resolve=True),
-        "object": object_name,
-        "trial": str(trial),
-        "trial_seed": str(seed),
-        "global_seed": str(cfg.seed),
-    }
+def job_metadata(cfg: DictConfig) -> dict[str, str]:
+    """The part of every trial's MCAP metadata that is the same for the whole job."""
+    meta = {"config_yaml": OmegaConf.to_yaml(cfg, resolve=True), "global_seed": str(cfg.seed)}
     meta.update({f"version.{k}": v for k, v in package_versions().items()})
     return meta
+
+
+def _metadata(job_meta: dict[str, str], object_name: str, trial: int, seed: int) -> dict[str, str]:
+    return {**job_meta, "object": object_name, "trial": str(trial), "trial_seed": str(seed)}
 
 
 def _error_result(
@@ -103,7 +102,8 @@ def run_object_trials(
 ) -> list[TrialResult]:
     """Every trial of one object; finished trials found in ``run_dir`` are read back instead of re-run."""
     plain = plain_config(cfg)
-    model = hulls = load_error = None
+    job_meta = job_metadata(cfg)
+    model = hulls = entities = load_error = None
     results = []
     for i in range(cfg.trials):
         path = trial_log_path(run_dir, object_name, i)
@@ -111,7 +111,7 @@ def run_object_trials(
         result = _finished(path)
         if result is None:
             path.parent.mkdir(parents=True, exist_ok=True)
-            with TrialRecorder(path, _metadata(cfg, object_name, i, seed)) as rec:
+            with TrialRecorder(path, _metadata(job_meta, object_name, i, seed)) as rec:
                 try:
                     if load_error is not None:
                         raise load_error
@@ -119,7 +119,8 @@ def run_object_trials(
                         cloud_seed = derive_seed(cfg.seed, "cloud", object_name)
                         model = load_object(cfg.dataset, object_name, cfg.planner.n_points, cloud_seed)
                         hulls = convex_hulls(model.mesh, plain.sim)
-                    result = run_trial(TrialContext(plain, model, hulls, i, seed, rec))
+                        entities = scene_entities(plain, hulls)
+                    result = run_trial(TrialContext(plain, model, hulls, i, seed, rec, entities))
                 except Exception as exc:  # one trial's error is recorded; the sweep goes on
                     if model is None:
                         load_error = exc

@@ -4,12 +4,9 @@ import os
 from pathlib import Path
 
 import pytest
-from hydra import compose, initialize_config_dir
-from hydra.core.global_hydra import GlobalHydra
 from omegaconf import DictConfig
 
-from graspexp.cli import CONF_DIR
-from graspexp.config import register_configs
+from graspexp.cli import compose_config
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -21,10 +18,7 @@ def shared_data_root() -> Path:
 
 def compose_cfg(*overrides: str) -> DictConfig:
     """The job config composed from ``conf/`` with Hydra overrides (no run directory, no logging)."""
-    register_configs()
-    GlobalHydra.instance().clear()
-    with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
-        return compose("config", overrides=list(overrides))
+    return compose_config(list(overrides))
 
 
 @pytest.fixture(scope="session", autouse=True)

@@ -134,7 +134,17 @@ def test_dictconfig_from_the_yaml_option_works(data_root):
     option.pop("defaults")  # Hydra's defaults list; the schema itself is what it names
     cfg = OmegaConf.merge(OmegaConf.structured(DatasetConfig), option, {"root": str(data_root)})
     assert dataset_objects(cfg) == list(DATASETS["linemod"].default_objects)
-    assert available_objects(cfg) == ["ape", "can", "cat", "driller", "duck", "eggbox", "glue", "holepuncher", "iron"]
+    assert available_objects(cfg) == [
+        "ape",
+        "can",
+        "cat",
+        "driller",
+        "duck",
+        "eggbox",
+        "glue",
+        "holepuncher",
+        "iron",
+    ]
     assert load_object(cfg, "glue", 64, 1).mesh.extents.max() == pytest.approx(0.17282, abs=1e-4)
 
 

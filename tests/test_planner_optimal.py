@@ -56,7 +56,12 @@ def _check_result(res, req):
     assert np.linalg.det(R) == pytest.approx(1.0, abs=1e-9)
     np.testing.assert_allclose(g.approach, det["directions"][kb, pb], atol=1e-12)
     assert abs(R[:, 0] @ R[:, 2]) < 1e-9
-    np.testing.assert_array_equal(g.position, det["centers"][kb])
+    # Origin: c_k moved along Y to the middle of the section between the pads.
+    shift = g.extras["centre_shift_m"]
+    assert shift == pytest.approx(det["section_span"][kb, pb].mean(), abs=1e-15)
+    np.testing.assert_allclose(g.position, det["centers"][kb] + shift * R[:, 1], atol=1e-12)
+    lo, hi = det["section_span"][kb, pb] - shift
+    assert -g.width_m / 2 <= lo <= hi <= g.width_m / 2  # both pads clear the section
     np.testing.assert_array_equal(g.pose, det["pose"])
     # The path starts above the support plane.
     start = det["centers"][kb] - req.planner.sphere_radius_m * det["directions"][kb, pb]
@@ -65,6 +70,8 @@ def _check_result(res, req):
     assert req.gripper.min_width_m <= g.width_m <= req.gripper.max_width_m
     assert g.width_m == det["width"]
     assert g.extras["slab_extent_m"] <= req.gripper.max_width_m
+    assert g.extras["slab_extent_m"] <= g.width_m  # the open fingers clear the section they close on
+    assert det["section_width"][kb, pb] == g.extras["slab_extent_m"]
     assert g.planner == "optimal" and g.extras["K"] == k and g.extras["M"] == m
     assert g.n_feasible == int(det["feasible"].sum())
 
@@ -167,6 +174,38 @@ def test_paths_found_too_wide_are_skipped_for_the_next_cheapest():
     assert res.grasp.extras["slab_extent_m"] <= 0.045
     assert (~res.details["feasible"]).sum() == res.grasp.extras["n_too_wide"]  # no table in reach
     assert res.grasp.cost == res.details["costs"].min()
+
+
+def test_a_band_shorter_than_its_diameter_is_closed_across_not_along_its_height():
+    # A 66 mm can whose area is a 40 mm band: PCA puts the main axis horizontal, so a horizontal
+    # approach would close the fingers along the can's height (100 mm section) with a ~75 mm opening.
+    # That section does not fit the r_k opening; the planner goes on to a path whose section does.
+    rng = np.random.default_rng(8)
+    pts = cylinder_cloud(rng, 2048, radius_m=0.033, height_m=0.10) + [0.0, 0.0, 0.1]
+    mask = (pts[:, 2] > 0.13) & (pts[:, 2] < 0.17)
+    req = request(pts, mask, table_z=0.1, planner=PlannerConfig(name="optimal"))
+    res = plan_optimal(req)
+    _check_result(res, req)
+    assert abs(res.details["main_axis"][2]) < 0.3
+    assert abs(res.grasp.pose[2, 1]) < 0.3  # closing axis Y is (nearly) horizontal
+    assert res.grasp.extras["slab_extent_m"] < 0.075
+    assert res.grasp.extras["n_too_wide"] > 0 and not res.grasp.extras["widened"]
+
+
+def test_opening_is_widened_when_no_section_fits_the_cluster_radius():
+    rng = np.random.default_rng(9)
+    pts = box_cloud(rng, 3000, (0.06, 0.06, 0.06))
+    mask = (
+        (np.abs(pts[:, 0] - 0.03) < 1e-9) & (np.abs(pts[:, 1]) < 0.004) & (np.abs(pts[:, 2] - 0.03) < 0.004)
+    )
+    assert 0 < mask.sum() < 30  # a tiny patch: r_k of a few mm, opening far below any section
+    req = request(pts, mask, table_z=-1.0, planner=PlannerConfig(name="optimal", m=64))
+    res = plan_optimal(req)
+    _check_result(res, req)
+    g = res.grasp
+    assert g.extras["widened"]
+    assert g.width_m > 2 * res.details["radii"][g.cluster] * 1.2
+    assert g.width_m == pytest.approx(min(g.extras["slab_extent_m"] * 1.2, RG2.max_width_m))
 
 
 def test_registry_dispatches_and_lists_names():

@@ -12,7 +12,7 @@ from graspexp.planning.pose import (
     grasp_rotation,
     grasp_rotations,
     opening_width_m,
-    slab_extents_m,
+    slab_spans_m,
 )
 
 
@@ -75,14 +75,15 @@ def test_width_is_twice_the_radius_with_margin_clipped_to_the_stroke():
         assert tight.min_width_m <= w <= tight.max_width_m
 
 
-def test_slab_extent_measures_the_section_between_the_pads():
-    # A thin bar along world y, 200 mm long, through the origin, plus a far point outside the slab.
-    bar = np.stack([np.zeros(201), np.linspace(-0.1, 0.1, 201), np.zeros(201)], axis=1)
+def test_slab_span_is_the_section_between_the_pads():
+    # A thin bar along world y from -40 mm to +100 mm through the grasp point, plus a far point.
+    bar = np.stack([np.zeros(141), np.linspace(-0.04, 0.1, 141), np.zeros(141)], axis=1)
     pts = np.vstack([bar, [[0.0, 0.5, 0.2]]])  # z = 0.2 m: beyond the pads, ignored
-    close_on_bar = grasp_rotation(np.array([0.0, 0.0, -1.0]), np.array([1.0, 0.0, 0.0]))  # Y = +-world y
+    close_on_bar = grasp_rotation(np.array([0.0, 0.0, -1.0]), np.array([1.0, 0.0, 0.0]))  # Y = -world y
     along_bar = grasp_rotation(np.array([0.0, 0.0, -1.0]), np.array([0.0, 1.0, 0.0]))  # X = world y
-    ext = slab_extents_m(pts, np.zeros(3), np.stack([close_on_bar, along_bar]), RG2)
-    assert ext[0] == pytest.approx(0.2)
-    assert ext[1] == pytest.approx(0.0)  # only the bar's centre lies in |x| <= 11 mm: zero width
-    empty = slab_extents_m(pts + [1.0, 0.0, 0.0], np.zeros(3), close_on_bar[None], RG2)
-    assert empty[0] == 0.0
+    np.testing.assert_allclose(close_on_bar[:, 1], [0.0, -1.0, 0.0], atol=1e-12)
+    spans = slab_spans_m(pts, np.zeros(3), np.stack([close_on_bar, along_bar]), RG2)
+    np.testing.assert_allclose(spans[0], [-0.1, 0.04], atol=1e-12)  # in grasp-frame y = -world y
+    np.testing.assert_allclose(spans[1], [0.0, 0.0], atol=1e-12)  # only the bar's centre is in |x| <= 11 mm
+    empty = slab_spans_m(pts + [1.0, 0.0, 0.0], np.zeros(3), close_on_bar[None], RG2)
+    np.testing.assert_array_equal(empty[0], [0.0, 0.0])

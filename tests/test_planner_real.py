@@ -11,14 +11,16 @@ from test_planner_common import RG2
 from graspexp.config import CostConfig, DatasetConfig, PlannerConfig
 from graspexp.datasets import load_object
 from graspexp.datasets.catalog import candidate_paths, dataset_spec
-from graspexp.planning import PlanRequest, plan
 from graspexp.plan import main as plan_main
 from graspexp.plan import split_args, upright_pose
+from graspexp.planning import PlanRequest, plan
 
 
 def _present(root, dataset):
     cfg = DatasetConfig(name=dataset, root=str(root), regions=f"{dataset}.yaml")
-    return cfg, [n for n in dataset_spec(dataset).catalogue if any(p.is_file() for p in candidate_paths(cfg, n))]
+    return cfg, [
+        n for n in dataset_spec(dataset).catalogue if any(p.is_file() for p in candidate_paths(cfg, n))
+    ]
 
 
 @pytest.mark.parametrize("dataset", ["ycb", "linemod"])
@@ -61,7 +63,9 @@ def test_plan_every_real_object_in_both_modes(data_root, dataset):
 
 
 def test_split_args_takes_object_and_dump_out_of_the_hydra_overrides():
-    found, rest = split_args(["dataset=ycb", "object=025_mug", "+dump=a.npz", "mode=bin", "objects=[x]"], ("object", "dump"))
+    found, rest = split_args(
+        ["dataset=ycb", "object=025_mug", "+dump=a.npz", "mode=bin", "objects=[x]"], ("object", "dump")
+    )
     assert found == {"object": "025_mug", "dump": "a.npz"}
     assert rest == ["dataset=ycb", "mode=bin", "objects=[x]"]
 
@@ -83,7 +87,11 @@ def test_plan_cli_prints_one_json_object_and_dumps(tmp_path, capsys, monkeypatch
         assert d["costs"].shape == d["feasible"].shape == d["directions"].shape[:2]
         np.testing.assert_allclose(d["pose"], pose)
         assert str(d["mode"]) == "bin"
-    # The object rests on the support: the cloud's lowest point is at (or just above) z = support.
+        # The object rests on the support z = mode.support_height_m (0.10 m): its mesh's lowest point
+        # is on the plane, so the sampled cloud starts at or just above it.
+        assert float(d["table_z"]) == pytest.approx(0.10)
+        assert 0.10 - 1e-9 <= d["cloud"][:, 2].min() < 0.105
+        np.testing.assert_array_equal(d["object_pose"][:3, :3], np.eye(3))
     assert not list(tmp_path.glob("outputs"))  # compose API: no Hydra run folder
 
 

@@ -143,7 +143,9 @@ def test_every_primitive_area_is_a_proper_subset():
 
 def test_every_real_mesh_has_a_non_empty_area(data_root):
     for ds in ("ycb", "linemod"):
-        cfg = DatasetConfig(name=ds, root=str(data_root), regions=f"{ds}.yaml", objects=list(DATASETS[ds].catalogue))
+        cfg = DatasetConfig(
+            name=ds, root=str(data_root), regions=f"{ds}.yaml", objects=list(DATASETS[ds].catalogue)
+        )
         for name in available_objects(cfg):
             share = load_object(cfg, name, 1024, 0).area_mask.mean()
             assert 0.1 < share <= 1.0, (name, share)
@@ -182,7 +184,9 @@ def test_meshlab_round_trip_metres_and_millimetres(tmp_path):
     assert mask_m[truth].all()  # every area point maps onto itself
     extra = mask_m & ~truth  # neighbours within the tolerance, only along the band's two edges
     assert extra.mean() < 0.02
-    assert np.all(np.minimum(np.abs(obj.points[extra, 2] - 0.05), np.abs(obj.points[extra, 2] - 0.12)) < 0.004)
+    assert np.all(
+        np.minimum(np.abs(obj.points[extra, 2] - 0.05), np.abs(obj.points[extra, 2] - 0.12)) < 0.004
+    )
 
 
 def test_meshlab_area_from_another_sampling_maps_with_a_tolerance(tmp_path):
@@ -216,11 +220,15 @@ def test_meshlab_file_found_under_the_data_root(tmp_path):
     obj = load_object(DatasetConfig(name="primitives", regions="primitives.yaml"), "can", 512, 0)
     trimesh.PointCloud(obj.mesh.vertices).export(root / "can_area.ply")
     (specs / "r.yaml").write_text("can:\n  meshlab_ply: can_area.ply\n  tolerance_m: 0.05\n")
-    can = load_object(DatasetConfig(name="primitives", root=str(root), regions=str(specs / "r.yaml")), "can", 512, 0)
+    can = load_object(
+        DatasetConfig(name="primitives", root=str(root), regions=str(specs / "r.yaml")), "can", 512, 0
+    )
     assert can.area_mask.all()
     (specs / "r.yaml").write_text("can:\n  meshlab_ply: missing.ply\n")
     with pytest.raises(DatasetError, match="MeshLab area file for object 'can'.*missing.ply"):
-        load_object(DatasetConfig(name="primitives", root=str(root), regions=str(specs / "r.yaml")), "can", 512, 0)
+        load_object(
+            DatasetConfig(name="primitives", root=str(root), regions=str(specs / "r.yaml")), "can", 512, 0
+        )
 
 
 def test_meshlab_import_rejects_a_single_point(tmp_path):

@@ -19,7 +19,13 @@ from tests.conftest import compose_cfg
 
 @pytest.mark.parametrize(
     ("k", "n", "lo", "hi"),
-    [(9, 10, 0.596, 0.982), (10, 10, 0.722, 1.0), (0, 10, 0.0, 0.278), (5, 10, 0.237, 0.763), (1, 2, 0.095, 0.905)],
+    [
+        (9, 10, 0.596, 0.982),
+        (10, 10, 0.722, 1.0),
+        (0, 10, 0.0, 0.278),
+        (5, 10, 0.237, 0.763),
+        (1, 2, 0.095, 0.905),
+    ],
 )
 def test_wilson_interval_matches_hand_computed_values(k: int, n: int, lo: float, hi: float) -> None:
     got = wilson_interval(k, n)
@@ -122,7 +128,9 @@ def test_table1_exact_percentages_intervals_and_deltas(sweep_dir: Path) -> None:
     mug = _cell(t1, "Mug", "collab", "z")
     assert (mug["ours_pct"], mug["lo_pct"], mug["hi_pct"]) == pytest.approx((100.0, 72.2, 100.0), abs=0.05)
     xyz = _cell(t1, "Cleanser B.", "collab", "xyz")
-    assert (xyz["ours_pct"], xyz["lo_pct"], xyz["hi_pct"], xyz["paper_pct"]) == pytest.approx((0, 0, 27.8, 90), abs=0.05)
+    assert (xyz["ours_pct"], xyz["lo_pct"], xyz["hi_pct"], xyz["paper_pct"]) == pytest.approx(
+        (0, 0, 27.8, 90), abs=0.05
+    )
     # objects without logs stay in the table as n/a, with the paper's value
     meat = _cell(t1, "Meat Can", "collab", "z")
     assert meat["n"] == 0 and np.isnan(meat["ours_pct"]) and meat["paper_pct"] == 90.0

@@ -29,3 +29,11 @@ class GripperConfig:
     """Coulomb friction of the finger pads (PhysX averages with the object's)."""
     finger_mass_kg: float = 0.05
     """Mass of each finger, kg."""
+    tcp_from_tip_m: float = 0.01
+    """Distance from the fingertips back to the TCP (the grasp point, the pads' centre) along -Z, m."""
+
+
+def finger_z_range_m(g: GripperConfig) -> tuple[float, float]:
+    """(z_min, z_max) of the fingers along the approach axis in the gripper frame, m: from the palm face
+    (z_min, where the palm box starts and extends further back by palm_size_m[2]) to the tips (z_max)."""
+    return g.tcp_from_tip_m - g.finger_length_m, g.tcp_from_tip_m

@@ -30,6 +30,34 @@ class PlannerConfig:
     """A path is dropped when its sphere point lies below the support plane plus this, m."""
     seed: int = 0
     """Seed of the K-means initialisation (combined with the trial seed)."""
+    main_axis: str = "object"
+    """Cloud whose first principal component is the main axis: ``object`` (the whole cloud; paper III-D:
+    "the main axis of the object ... by reducing the dimensionality of the object's point cloud", humans
+    grasp orthogonally to it) or ``area`` (the grasping area, as drawn in the paper's Fig. 7). The area's
+    axis is ill-conditioned for bands around cylinders (two near-equal eigenvalues), hence the default."""
+    auto_k_stroke_fraction: float = 0.5
+    """``k: auto``: K = clamp(ceil(L / (fraction * gripper.max_width_m)), 1, k_max), L = area extent along
+    the main axis."""
+
+    # --- Baselines and optimal_plus (graspexp/planning/{antipodal,obb,random_grasp,optimal_plus}.py) ---
+    # Optional: every field has a default, so the paper's ``optimal`` config is unchanged.
+    n_candidates: int = 256
+    """antipodal: first-contact points sampled; random: draws before giving up."""
+    n_approach: int = 12
+    """antipodal: approach directions tried about each contact pair's line (evenly spaced)."""
+    friction_coef: float = 0.5
+    """antipodal: friction coefficient mu of the sampling cone, half-angle atan(mu) (dimensionless)."""
+    sample_area_only: bool = False
+    """antipodal: draw contacts from the grasping area only (False: from the whole cloud, as GPD)."""
+    approach_tilt_weight: float = 0.1
+    """antipodal: cost per degree between the approach and straight down, added to the contacts' worst
+    friction-cone angle (degrees), so top-down approaches win among equally antipodal pairs."""
+    collision_margin_m: float = 0.002
+    """Clearance the finger and palm boxes keep from cloud points and from the support plane, m."""
+    width_clearance_m: float = 0.005
+    """obb, antipodal, optimal_plus: opening = 2 * (largest |y| of the object between the pads) + 2 * this, m."""
+    com_weight: float = 1.0
+    """optimal_plus: cost factor (1 + com_weight * |c_k - centroid| / object size); 0 switches it off."""
 
 
 @dataclass

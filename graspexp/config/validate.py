@@ -47,6 +47,8 @@ CONSTRAINTS: dict[str, tuple[Callable[[object], bool], str]] = {
     "planner.k_max": (lambda v: v >= 1, "a positive integer"),
     "planner.m": (lambda v: v >= 1, "a positive integer"),
     "planner.n_points": (lambda v: v >= 16, "an integer >= 16"),
+    "planner.main_axis": (lambda v: v in ("object", "area"), "one of object, area"),
+    "planner.auto_k_stroke_fraction": (_positive, "a positive number"),
     "planner.sphere_radius_m": (_positive, "a positive number"),
     "planner.width_margin": (_non_negative, "a non-negative number"),
     "sim.timestep_s": (lambda v: 0 < v <= 0.02, "a step in (0, 0.02] s"),

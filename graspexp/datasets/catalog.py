@@ -215,4 +215,3 @@ def available_objects(cfg: Any) -> list[str]:
     if cfg.name == "primitives":
         return dataset_objects(cfg)
     return [n for n in dataset_objects(cfg) if any(p.is_file() for p in candidate_paths(cfg, n))]
-

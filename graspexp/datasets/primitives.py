@@ -74,9 +74,7 @@ def box() -> trimesh.Trimesh:
 
 def bottle() -> trimesh.Trimesh:
     """Bottle: body diameter 60 mm up to 140 mm, conical shoulder, neck diameter 24 mm, 190 mm tall."""
-    return _revolve(
-        [(0.0, 0.0), (0.030, 0.0), (0.030, 0.140), (0.012, 0.165), (0.012, 0.190), (0.0, 0.190)]
-    )
+    return _revolve([(0.0, 0.0), (0.030, 0.0), (0.030, 0.140), (0.012, 0.165), (0.012, 0.190), (0.0, 0.190)])
 
 
 def mug() -> trimesh.Trimesh:

@@ -171,8 +171,10 @@ def _parse_entry(name: str, entry: Any, path: Path) -> RegionSpec:
 
 def _parse_op(op: Any, relative: bool, where: str) -> RegionOp:
     if not isinstance(op, dict) or len(op) != 1:
-        raise DatasetError(f"{where}: an operation is a one-key mapping such as {{keep_box: {{...}}}}, got {op!r}")
-    (kind, params), = op.items()
+        raise DatasetError(
+            f"{where}: an operation is a one-key mapping such as {{keep_box: {{...}}}}, got {op!r}"
+        )
+    ((kind, params),) = op.items()
     if kind not in _OP_NAMES:
         raise DatasetError(f"{where}: unknown operation {kind!r}; valid: {', '.join(sorted(_OP_NAMES))}")
     mode, shape = kind.split("_", 1)

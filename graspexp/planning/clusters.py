@@ -26,7 +26,8 @@ from sklearn import config_context
 from sklearn.cluster import KMeans
 
 AUTO_K_STROKE_FRACTION = 0.5
-"""``c`` in the ``k: auto`` rule: one cluster per ``c * gripper.max_width_m`` of area length."""
+"""Default ``c`` in the ``k: auto`` rule (``planner.auto_k_stroke_fraction``): one cluster per
+``c * gripper.max_width_m`` of area length."""
 
 KMEANS_N_INIT = 1
 """K-means++ restarts; one suffices on these small, well-separated clouds and keeps latency low."""
@@ -62,13 +63,18 @@ def extent_along(points_m: np.ndarray, axis: np.ndarray) -> float:
 
 
 def choose_k(
-    k: object, k_max: int, area_points_m: np.ndarray, axis: np.ndarray, gripper_max_width_m: float
+    k: object,
+    k_max: int,
+    area_points_m: np.ndarray,
+    axis: np.ndarray,
+    gripper_max_width_m: float,
+    stroke_fraction: float = AUTO_K_STROKE_FRACTION,
 ) -> int:
     """Number of clusters: ``k`` if an int, else the ``auto`` rule of the module doc; at most n_area."""
     n_area = len(area_points_m)
     if k == "auto":
         length_m = extent_along(area_points_m, axis)
-        chosen = math.ceil(length_m / (AUTO_K_STROKE_FRACTION * gripper_max_width_m))
+        chosen = math.ceil(length_m / (stroke_fraction * gripper_max_width_m))
         chosen = min(max(chosen, 1), int(k_max))
     else:
         chosen = int(k)

@@ -12,12 +12,24 @@ Steps (the cloud arrives already transformed by the object pose: world frame, me
 6. cost Eq. (1) (collab) or Eq. (2)-(3) (bin) of every remaining path (:mod:`.cost`); removed paths
    cost ``inf``;
 7. paths are taken in ascending cost (stable order: cluster-major, then path index) and the first
-   whose pads' sweep fits the gripper (:func:`.pose.slab_extents_m` <= ``max_width_m``) wins. Checking
-   lazily in cost order picks exactly the argmin over paths passing both tests; the paths found too
-   wide get cost ``inf`` and ``feasible`` False, the unexamined ones keep their table verdict;
-8. pose per Fig. 9 and opening width from ``r_k`` (:mod:`.pose`).
+   whose object section between the pads (:func:`.pose.slab_spans_m`, extent ``y_hi - y_lo``) fits its opening
+   ``w_k = clip(2 r_k (1 + width_margin), min_width, max_width)`` wins: the fingers, opened as the paper
+   prescribes, clear what they close on. Checking lazily in cost order picks exactly the argmin over
+   the paths passing both tests; examined paths that fail get cost ``inf`` and ``feasible`` False,
+   unexamined ones keep their table verdict. If no path's section fits its ``w_k`` (all were then
+   examined), the cheapest path whose section fits the stroke ``max_width`` is taken and the opening is
+   widened to ``clip(section (1 + width_margin), min_width, max_width)`` (``extras["widened"]``); if
+   none fits the stroke either: ``NoFeasibleGrasp("object wider than the gripper ...")``;
+8. pose per Fig. 9 and opening width from ``r_k`` (:mod:`.pose`); the origin is ``c_k`` moved along the
+   closing axis Y to the middle of the section (``extras["centre_shift_m"]``), since the pads close
+   symmetrically about it.
 
-``Grasp.n_feasible`` counts the paths that survive step 5 minus those found too wide in step 7.
+``Grasp.n_feasible`` is the number of paths still ``feasible`` after step 7. ``details`` holds ``cloud``,
+``area_mask``, ``labels`` (K-means label of each area point), ``centers``, ``radii`` (m), ``main_axis``,
+``directions`` (K, M, 3), ``feasible`` (K, M), ``costs`` (K, M; inf where infeasible),
+``section_width`` (K, M; m, nan where not examined), ``section_span`` (K, M, 2; [y_lo, y_hi] about c_k,
+m), ``best`` (k, p), ``pose``, ``width``, ``mode``, ``table_z``, ``sphere_radius`` and
+``gripper_max_width``.
 """
 
 import numpy as np
@@ -26,14 +38,14 @@ from graspexp.planning.clusters import choose_k, main_axis, segment
 from graspexp.planning.cost import cluster_costs
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.paths import above_support, approach_directions
-from graspexp.planning.pose import grasp_pose, grasp_rotations, opening_width_m, slab_extents_m
+from graspexp.planning.pose import grasp_pose, grasp_rotations, opening_width_m, slab_spans_m
 from graspexp.planning.request import PlanRequest, PlanResult
 from graspexp.seeding import derive_seed
 
 NAME = "optimal"
 
 WIDTH_CHECK_BATCH = 16
-"""Paths checked per batch by the lazy wider-than-gripper test (after the cheapest one alone)."""
+"""Paths checked per batch by the lazy section test of step 7 (after the cheapest one alone)."""
 
 
 def kmeans_random_state(seed: int, planner_seed: int) -> int:
@@ -63,8 +75,8 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
         raise NoFeasibleGrasp("the grasping area is empty: no point of the cloud is in area_mask")
 
     pl, gr = req.planner, req.gripper
-    axis = main_axis(area)
-    k = choose_k(pl.k, pl.k_max, area, axis, gr.max_width_m)
+    axis = main_axis(points if pl.main_axis == "object" else area)
+    k = choose_k(pl.k, pl.k_max, area, axis, gr.max_width_m, pl.auto_k_stroke_fraction)
     clusters = segment(area, k, random_state=kmeans_random_state(req.seed, pl.seed))
     centers, radii = clusters.centers_m, clusters.radii_m
     k = len(centers)
@@ -95,46 +107,67 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
                 req.cost,
             )
 
+    openings = np.array([opening_width_m(float(r), pl.width_margin, gr) for r in radii])  # (K,) m
+    spans = np.full((k, m, 2), np.nan)  # [y_lo, y_hi] of the section between the pads (nan: not examined)
+    section = np.full((k, m), np.nan)  # its extent, m
     order = np.argsort(costs, axis=None, kind="stable")[:n_table_ok]
     best = None
-    slab_extent = 0.0
-    n_too_wide = 0
     start, size = 0, 1  # the cheapest path nearly always fits: check it alone, then in batches
     while best is None and start < len(order):
         batch = order[start : start + size]
         start, size = start + len(batch), WIDTH_CHECK_BATCH
         ks, ps = np.unravel_index(batch, (k, m))
-        extents = np.empty(len(batch))
         for kk in np.unique(ks):
             sel = ks == kk
             rots = grasp_rotations(directions[kk, ps[sel]], axis)
-            extents[sel] = slab_extents_m(points, centers[kk], rots, gr)
-        for kk, pp, ext in zip(ks, ps, extents, strict=True):
-            if ext > gr.max_width_m:
-                feasible[kk, pp] = False
-                costs[kk, pp] = np.inf
-                n_too_wide += 1
-            else:
-                best, slab_extent = (int(kk), int(pp)), float(ext)
+            spans[kk, ps[sel]] = slab_spans_m(points, centers[kk], rots, gr)
+        section = spans[..., 1] - spans[..., 0]
+        for kk, pp in zip(ks, ps, strict=True):
+            if section[kk, pp] <= openings[kk]:
+                best = (int(kk), int(pp))
                 break
-    if best is None:
-        raise NoFeasibleGrasp(
-            f"object wider than the gripper: on all {n_table_ok} paths above the support the object's "
-            f"section between the pads exceeds gripper.max_width_m = {gr.max_width_m} m"
-        )
+    widened = best is None
+    if widened:
+        # Fallback: no section fits its r_k opening; every path above the support was examined. Keep
+        # those whose section fits the stroke and open to the section plus margin.
+        fits = feasible & (section <= gr.max_width_m)
+        if not fits.any():
+            raise NoFeasibleGrasp(
+                f"object wider than the gripper: on all {n_table_ok} paths above the support the object's "
+                f"section between the pads exceeds gripper.max_width_m = {gr.max_width_m} m"
+            )
+        flat = int(np.argmin(np.where(fits, costs, np.inf)))
+        best = (flat // m, flat % m)
+    else:
+        fits = feasible & ~(section > openings[:, None])  # unexamined paths keep their table verdict
+    n_too_wide = int((feasible & ~fits).sum())
+    feasible &= fits
+    costs[~feasible] = np.inf
 
     kb, pb = best
+    slab_extent = float(section[kb, pb])
     pose = grasp_pose(centers[kb], directions[kb, pb], axis)
-    width = opening_width_m(float(radii[kb]), pl.width_margin, gr)
+    shift_m = float(spans[kb, pb].mean())  # centre the symmetric pads on the section (pose.py doc)
+    pose[:3, 3] += shift_m * pose[:3, 1]
+    width = float(openings[kb])
+    if widened:
+        width = float(np.clip(slab_extent * (1.0 + pl.width_margin), gr.min_width_m, gr.max_width_m))
     grasp = Grasp(
         pose=pose,
         width_m=width,
         cost=float(costs[kb, pb]),
         cluster=kb,
         path=pb,
-        n_feasible=n_table_ok - n_too_wide,
+        n_feasible=int(feasible.sum()),
         planner=NAME,
-        extras={"K": k, "M": m, "n_too_wide": n_too_wide, "slab_extent_m": slab_extent},
+        extras={
+            "K": k,
+            "M": m,
+            "n_too_wide": n_too_wide,
+            "slab_extent_m": slab_extent,
+            "centre_shift_m": shift_m,
+            "widened": widened,
+        },
     )
     details = {
         "cloud": points,
@@ -146,6 +179,8 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
         "directions": directions,
         "feasible": feasible,
         "costs": costs,
+        "section_width": section,
+        "section_span": spans,
         "best": np.array([kb, pb]),
         "pose": pose,
         "width": np.float64(width),

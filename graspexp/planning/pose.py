@@ -10,16 +10,24 @@ Frame
 Width
     ``clip(2 r_k (1 + width_margin), gripper.min_width_m, gripper.max_width_m)``, metres.
 
-Wider than the gripper
+Section between the pads
     In the grasp frame, take the object points inside the pads' sweep: ``|x| <= finger_width/2`` and
-    ``|z| <= finger_length/2`` (pads centred on the grasp point). Their extent along Y (max - min) is the
-    object's section the fingers must close around; a path is unusable when that exceeds
-    ``gripper.max_width_m``. No points in the slab: extent 0 (nothing to squeeze, the test passes).
+    ``z`` within the fingers' extent (:func:`graspexp.config.gripper.finger_z_range_m`). Their span ``[y_lo, y_hi]`` along the
+    closing axis is the section the fingers close on (:func:`slab_spans_m`); its extent
+    ``y_hi - y_lo`` is the opening it needs. The pads close symmetrically, so the planner moves the
+    grasp point along Y to the section's middle, ``c_k + (y_lo + y_hi)/2 * Y`` (the paper's c_k is a
+    mean of surface points and can sit off the section's middle, e.g. half a ring for K = 2); X, Y, Z
+    are unchanged. The planner (:mod:`.optimal`, step 7) keeps a path only if the extent fits the
+    opening, and reports ``NoFeasibleGrasp("object wider than the gripper ...")`` when no path's extent
+    fits even the stroke ``max_width_m``. No points in the slab: span [0, 0] (nothing to squeeze). Only
+    the pads' region is checked: the palm and the fingers' travel behind it are not (the paper's cost is
+    what steers paths away from the object).
 """
 
 import numpy as np
 
 from graspexp.config import GripperConfig
+from graspexp.config.gripper import finger_z_range_m
 
 PARALLEL_TOL = 1e-6
 """Below this norm of the Gram-Schmidt residual the main axis counts as parallel to the approach."""
@@ -64,23 +72,24 @@ def opening_width_m(r_k_m: float, width_margin: float, gripper: GripperConfig) -
     return float(np.clip(2.0 * r_k_m * (1.0 + width_margin), gripper.min_width_m, gripper.max_width_m))
 
 
-def slab_extents_m(
+def slab_spans_m(
     points_m: np.ndarray, center_m: np.ndarray, rotations: np.ndarray, gripper: GripperConfig
 ) -> np.ndarray:
-    """Object extent along +Y inside the pads' sweep, for a batch of grasp frames.
+    """Span ``[y_lo, y_hi]`` along +Y of the object points in the pads' sweep (module doc).
 
-    points_m : (N, 3) world, metres; center_m : (3,); rotations : (B, 3, 3) grasp rotations.
+    points_m : (N, 3) world, metres; center_m : (3,) cluster centre; rotations : (B, 3, 3) grasp rotations.
 
     Returns
     -------
-    (B,) float64 extents, metres (0 where no point falls in the slab).
+    (B, 2) float64, metres, relative to ``center_m`` ([0, 0] where no point falls in the slab).
     """
     rel = np.asarray(points_m, dtype=np.float64) - center_m
     local = rel @ rotations  # (B, N, 3) grasp-frame coordinates
-    inside = (np.abs(local[..., 0]) <= gripper.finger_width_m / 2) & (
-        np.abs(local[..., 2]) <= gripper.finger_length_m / 2
-    )
+    z_lo, z_hi = finger_z_range_m(gripper)
+    z = local[..., 2]
+    inside = (np.abs(local[..., 0]) <= gripper.finger_width_m / 2) & (z >= z_lo) & (z <= z_hi)
     y = local[..., 1]
     hi = np.where(inside, y, -np.inf).max(axis=1)
     lo = np.where(inside, y, np.inf).min(axis=1)
-    return np.where(inside.any(axis=1), hi - lo, 0.0)
+    any_in = inside.any(axis=1)
+    return np.stack([np.where(any_in, lo, 0.0), np.where(any_in, hi, 0.0)], axis=1)

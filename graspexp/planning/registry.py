@@ -42,3 +42,22 @@ def get_planner(name: str) -> Planner:
 def plan(req: PlanRequest) -> PlanResult:
     """Dispatch on ``req.planner.name``."""
     return get_planner(req.planner.name)(req)
+
+
+# Baselines and the improved planner (graspexp/planning/{antipodal,obb,random_grasp,optimal_plus}.py).
+from graspexp.planning.antipodal import NAME as ANTIPODAL_NAME  # noqa: E402
+from graspexp.planning.antipodal import plan_antipodal  # noqa: E402
+from graspexp.planning.obb import NAME as OBB_NAME  # noqa: E402
+from graspexp.planning.obb import plan_obb  # noqa: E402
+from graspexp.planning.optimal_plus import NAME as OPTIMAL_PLUS_NAME  # noqa: E402
+from graspexp.planning.optimal_plus import plan_optimal_plus  # noqa: E402
+from graspexp.planning.random_grasp import NAME as RANDOM_NAME  # noqa: E402
+from graspexp.planning.random_grasp import plan_random  # noqa: E402
+
+for _name, _fn in (
+    (ANTIPODAL_NAME, plan_antipodal),
+    (OBB_NAME, plan_obb),
+    (RANDOM_NAME, plan_random),
+    (OPTIMAL_PLUS_NAME, plan_optimal_plus),
+):
+    register_planner(_name, _fn)

@@ -30,8 +30,8 @@ CHUNK_SIZE_BYTES = 1024 * 1024
 SCENE_SIGNIFICANT_DIGITS = 6
 """Floats in /scene messages are rounded to this many significant digits to keep meshes small."""
 
-CONTACT_SIGNIFICANT_DIGITS = 6
-"""Floats in /contacts messages are rounded to this many significant digits (the bulk of a log).
+CONTACT_DECIMALS = {"position": 6, "normal": 6, "force_n": 4, "separation_m": 7}
+"""Decimals kept per /contacts quantity (m, unit, N, m): the bulk of a log.
 /tf, /grasp and /result keep full float64 precision."""
 
 PARTIAL_SUFFIX = ".partial"
@@ -79,6 +79,13 @@ def _vec3(values: Any, what: str) -> list[float]:
     if arr.shape != (3,):
         raise ValueError(f"{what} must have 3 components, got shape {np.shape(values)}")
     return [float(v) for v in arr]
+
+
+def _rows(items: list[dict], key: str, what: str) -> np.ndarray:
+    arr = np.asarray([c[key] for c in items], dtype=float)
+    if arr.shape != (len(items), 3):
+        raise ValueError(f"{what} must have 3 components, got shape {arr.shape[1:]}")
+    return arr
 
 
 def _rgba(color: Sequence[float]) -> dict[str, float]:
@@ -239,50 +246,69 @@ class TrialWriter:
         """/tf, one foxglove.FrameTransform per child frame, parent ``world``.
 
         frames : child frame -> (position (3,) world frame m, quaternion (4,) SAPIEN order w, x, y, z).
-        The rotation is written in Foxglove order {x, y, z, w}.
+        The rotation is written in Foxglove order {x, y, z, w}. This is the hot path of a trial log, so
+        messages are built from plain floats without the generic :func:`to_json_value` walk.
         """
         ts = stamp(t_s)
         for child, (pos, quat_wxyz) in frames.items():
+            p = np.asarray(pos, dtype=float).reshape(-1)
             q = np.asarray(quat_wxyz, dtype=float).reshape(-1)
-            if q.shape != (4,):
-                raise ValueError(f"frame {child!r}: quaternion must be (w, x, y, z), got {quat_wxyz!r}")
+            if p.shape != (3,) or q.shape != (4,):
+                raise ValueError(
+                    f"frame {child!r}: need position (3,) and quaternion (w, x, y, z), got {pos!r}, {quat_wxyz!r}"
+                )
+            if not (np.all(np.isfinite(p)) and np.all(np.isfinite(q))):
+                raise ValueError(f"frame {child!r}: non-finite pose {pos!r}, {quat_wxyz!r}")
             x, y, z, w = wxyz_to_xyzw(q).tolist()
-            p = _vec3(pos, f"frame {child!r} position")
+            px, py, pz = p.tolist()
             msg = {
                 "timestamp": ts,
                 "parent_frame_id": "world",
                 "child_frame_id": child,
-                "translation": to_json_value(dict(zip("xyz", p, strict=True))),
-                "rotation": to_json_value({"x": x, "y": y, "z": z, "w": w}),
+                "translation": {"x": px, "y": py, "z": pz},
+                "rotation": {"x": x, "y": y, "z": z, "w": w},
             }
             self._write(S.TOPIC_TF, t_s, msg)
 
     def contacts(self, t_s: float, contacts: list[dict]) -> None:
         """/contacts, graspexp.Contacts@1: one message with every contact point of the step.
 
-        Floats are rounded to CONTACT_SIGNIFICANT_DIGITS significant digits.
-
         Each dict: body0, body1 (names), position (3,) world m, normal (3,) world, force_n: (3,) world-frame
         force on body0 in N, or a scalar magnitude along ``normal``; separation_m (float, default 0).
+        Numbers are rounded (vectorised) to CONTACT_DECIMALS decimals per quantity: 1 um positions,
+        1e-6 normals, 0.1 mN forces, 0.1 um separations.
         """
         out = []
-        for c in contacts:
-            normal = _vec3(c["normal"], "contact normal")
-            force = c["force_n"]
-            force_vec = (
-                [float(force) * n for n in normal] if np.ndim(force) == 0 else _vec3(force, "contact force_n")
+        if contacts:
+            pos = _rows(contacts, "position", "contact position")
+            normal = _rows(contacts, "normal", "contact normal")
+            force = np.array(
+                [
+                    np.asarray(c["force_n"], dtype=float) * (normal[i] if np.ndim(c["force_n"]) == 0 else 1.0)
+                    for i, c in enumerate(contacts)
+                ],
+                dtype=float,
+            ).reshape(-1, 3)
+            sep = np.array([float(c.get("separation_m", 0.0)) for c in contacts])
+            d = CONTACT_DECIMALS
+            cols = (
+                np.round(pos, d["position"]).tolist(),
+                np.round(normal, d["normal"]).tolist(),
+                np.round(force, d["force_n"]).tolist(),
+                np.round(sep, d["separation_m"]).tolist(),
             )
-            out.append(
-                {
-                    "body0": str(c["body0"]),
-                    "body1": str(c["body1"]),
-                    "position": _vec3(c["position"], "contact position"),
-                    "normal": normal,
-                    "force_n": force_vec,
-                    "separation_m": float(c.get("separation_m", 0.0)),
-                }
-            )
-        msg = {"timestamp": stamp(t_s), "contacts": to_json_value(out, CONTACT_SIGNIFICANT_DIGITS)}
+            for c, p, n, f, sp in zip(contacts, *cols, strict=True):
+                out.append(
+                    {
+                        "body0": str(c["body0"]),
+                        "body1": str(c["body1"]),
+                        "position": p,
+                        "normal": n,
+                        "force_n": f,
+                        "separation_m": sp,
+                    }
+                )
+        msg = {"timestamp": stamp(t_s), "contacts": to_json_value(out)}
         self._write(S.TOPIC_CONTACTS, t_s, msg)
 
     def grasp(self, t_s: float, grasp: Mapping[str, Any]) -> None:

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import sapien
 
-from graspexp.config import GripperConfig
+from graspexp.config.gripper import GripperConfig, finger_z_range_m
 from graspexp.geometry import matrix_to_quat_wxyz
 from graspexp.sim.scene import GRIPPER_BIT, OBJECT_BIT, SUPPORT_BIT, set_groups
 
@@ -93,7 +93,7 @@ def build_gripper(
     palm = link
     palm.set_name(PALM_NAME)
     L = float(cfg.finger_length_m)
-    root_z = -0.75 * L  # finger roots (palm face) sit 3/4 of a finger behind the TCP
+    root_z, _ = finger_z_range_m(cfg)  # the palm face, where the fingers start
     px, py, pz = cfg.palm_size_m
     palm.add_box_collision(
         sapien.Pose([0.0, 0.0, root_z - pz / 2]), half_size=[px / 2, py / 2, pz / 2], material=pad

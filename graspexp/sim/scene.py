@@ -1,7 +1,7 @@
 """A fresh physics-only SAPIEN scene per trial: the support and the dropped object.
 
-World frame: z up, metres. The support is a static box whose top is the plane z = h
-(``mode.support_height_m``). Collision filtering uses SAPIEN's groups: two shapes collide when
+World frame: z up, metres. The support is a static box on the floor (z = 0) whose top is the plane
+z = h (``mode.support_height_m``); the floor touches the object only. Collision filtering uses SAPIEN's groups: two shapes collide when
 ``(A[0] & B[1]) or (A[1] & B[0])``; the bits below say what each body is and what it touches.
 """
 
@@ -13,8 +13,8 @@ import sapien
 from graspexp.config import ModeConfig, SimConfig
 from graspexp.geometry import matrix_to_quat_wxyz, quat_wxyz_to_matrix
 
-OBJECT_BIT, SUPPORT_BIT, GRIPPER_BIT = 1, 2, 4
-OBJECT_NAME, SUPPORT_NAME = "object", "support"
+OBJECT_BIT, SUPPORT_BIT, GRIPPER_BIT, GROUND_BIT = 1, 2, 4, 8
+OBJECT_NAME, SUPPORT_NAME, GROUND_NAME = "object", "support", "ground"
 
 
 def configure_physx(cfg: SimConfig) -> None:
@@ -83,6 +83,10 @@ def build_scene(
     h = float(mode.support_height_m)
 
     support_mat = sapien.physx.PhysxMaterial(sim.support_friction, sim.support_friction, 0.0)
+    ground = scene.create_actor_builder()  # the floor under the support: catches objects that fall off
+    ground.add_plane_collision(sapien.Pose(q=[0.7071068, 0.0, -0.7071068, 0.0]), material=support_mat)
+    floor = ground.build_static(GROUND_NAME)
+    set_groups(floor.find_component_by_type(sapien.physx.PhysxRigidStaticComponent), GROUND_BIT, OBJECT_BIT)
     builder = scene.create_actor_builder()
     hx, hy = mode.support_half_size_m
     builder.add_box_collision(half_size=[hx, hy, h / 2], material=support_mat)
@@ -112,5 +116,5 @@ def build_scene(
     scene.add_entity(entity)
     body.mass = float(mass_kg)
     body.angular_damping = float(sim.object_angular_damping)
-    set_groups(body, OBJECT_BIT, SUPPORT_BIT | GRIPPER_BIT)
+    set_groups(body, OBJECT_BIT, SUPPORT_BIT | GRIPPER_BIT | GROUND_BIT)
     return TrialScene(scene=scene, object_entity=entity, object_body=body, support=support, table_z=h)

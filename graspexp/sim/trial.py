@@ -11,6 +11,7 @@ import numpy as np
 from omegaconf import DictConfig, OmegaConf
 
 from graspexp.config import JobConfig
+from graspexp.config.gripper import finger_z_range_m
 from graspexp.datasets.model import ObjectModel
 from graspexp.geometry import axis_angle_matrix, make_pose, random_rotation, transform_points, yaw_rotation
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
@@ -22,6 +23,8 @@ from graspexp.sim.gripper import FINGER_NAMES, Gripper, build_gripper
 from graspexp.sim.outcome import FailureReason, TrialResult
 from graspexp.sim.scene import TrialScene, build_scene
 
+FELL_BELOW_M = 0.05
+"""An object whose origin is this far below the support plane has fallen off it, m."""
 MIN_FINGER_FORCE_N = 0.5
 """A finger holds the object when it presses with at least this force."""
 
@@ -52,6 +55,8 @@ class TrialContext:
     trial: int
     trial_seed: int
     recorder: object = field(default_factory=NullRecorder)
+    entities: list[dict] | None = None
+    """The static scene for the log (:func:`scene_entities`); computed per trial when None."""
 
 
 def plain_config(cfg: DictConfig) -> JobConfig:
@@ -112,7 +117,9 @@ class _Sim:
             self.step()
 
     def step(self) -> None:
+        t0 = time.perf_counter()
         self.ts.scene.step()
+        self.timings["physics"] += time.perf_counter() - t0
         self.steps += 1
         self.t = self.steps * self.dt
         self._check_stable()
@@ -166,12 +173,15 @@ class _Sim:
 
 
 def _settle(sim: _Sim) -> bool:
-    """Step until the object rests (or the time cap); True if it is still on the support."""
+    """Step until the object rests, falls below the support, or the time cap; True if it is on the support."""
     cfg = sim.cfg.sim
-    body = sim.ts.object_body
+    body, entity = sim.ts.object_body, sim.ts.object_entity
     min_steps = int(cfg.settle_min_s / sim.dt)
+    below_z = sim.ts.table_z - FELL_BELOW_M
     for _ in range(int(cfg.settle_max_s / sim.dt)):
         sim.step()
+        if entity.pose.p[2] < below_z:
+            return False
         if sim.steps >= min_steps and (
             np.linalg.norm(body.linear_velocity) < cfg.settle_linear_mps
             and np.linalg.norm(body.angular_velocity) < cfg.settle_angular_radps
@@ -181,24 +191,22 @@ def _settle(sim: _Sim) -> bool:
 
 
 def _on_support(ts: TrialScene, cfg: JobConfig) -> bool:
+    """The object's lowest point is at the support top and its centre of mass is over the support."""
     lo = ts.object_body.compute_global_aabb_tight()[0]
-    com = ts.object_entity.pose.p
+    com = (ts.object_entity.pose * ts.object_body.cmass_local_pose).p
     hx, hy = cfg.mode.support_half_size_m
     return bool(lo[2] > ts.table_z - 0.01 and abs(com[0]) <= hx and abs(com[1]) <= hy)
 
 
-def _scene_entities(ctx: TrialContext, table_z: float) -> list[dict]:
+def scene_entities(cfg: JobConfig, hulls: list[np.ndarray]) -> list[dict]:
+    """Foxglove scene entities: the support (world frame) and the object's collision hulls (object frame)."""
     from graspexp.record import box_entity, mesh_entity
     from graspexp.sim.collision import hull_meshes
 
-    mode = ctx.cfg.mode
-    hx, hy = mode.support_half_size_m
-    ents = [
-        box_entity(
-            "support", "world", [0.0, 0.0, table_z / 2], [2 * hx, 2 * hy, table_z], [0.6, 0.45, 0.3, 1.0]
-        )
-    ]
-    for i, m in enumerate(hull_meshes(ctx.hulls)):
+    h = cfg.mode.support_height_m
+    hx, hy = cfg.mode.support_half_size_m
+    ents = [box_entity("support", "world", [0.0, 0.0, h / 2], [2 * hx, 2 * hy, h], [0.6, 0.45, 0.3, 1.0])]
+    for i, m in enumerate(hull_meshes(hulls)):
         ents.append(mesh_entity(f"object_hull_{i}", "object", m.vertices, m.faces, [0.2, 0.4, 0.9, 1.0]))
     return ents
 
@@ -208,7 +216,7 @@ def _gripper_entities(cfg: JobConfig) -> list[dict]:
 
     g = cfg.gripper
     L, t = g.finger_length_m, g.finger_thickness_m
-    root_z = -0.75 * L
+    root_z, _ = finger_z_range_m(g)
     px, py, pz = g.palm_size_m
     grey = [0.5, 0.5, 0.5, 1.0]
     ents = [box_entity("palm", "palm", [0.0, 0.0, root_z - pz / 2], [px, py, pz], grey)]
@@ -247,7 +255,7 @@ def run_trial(ctx: TrialContext) -> TrialResult:
         success=False,
         reason=None,
     )
-    timings = dict.fromkeys(("build", "settle", "plan", "execute", "log"), 0.0)
+    timings = dict.fromkeys(("build", "settle", "plan", "execute", "log", "physics"), 0.0)
     sim: _Sim | None = None
     try:
         sim = _drop_until_on_support(ctx, res, timings)
@@ -279,7 +287,9 @@ def _drop_until_on_support(ctx: TrialContext, res: TrialResult, timings: dict) -
         timings["build"] += time.perf_counter() - t0
         sim = _Sim(ts, cfg, ctx.recorder, timings)
         if attempt == 0:
-            ctx.recorder.scene(0.0, _scene_entities(ctx, ts.table_z))
+            ctx.recorder.scene(
+                0.0, ctx.entities if ctx.entities is not None else scene_entities(cfg, ctx.hulls)
+            )
         sim.phase("drop", {"attempt": attempt})
         with sim.timed("settle"):
             on_support = _settle(sim)

@@ -1,0 +1,198 @@
+"""Read every trial log below a directory and compare planners on the same drops.
+
+Rows come from each log's ``/result`` (:func:`graspexp.record.read_result`) plus the pose-noise level
+of its run, read from the ``config_yaml`` entry of the log's ``graspexp`` metadata record
+(``perception.noise.trans_mm``, mm, and ``perception.noise.rot_deg``, degrees; 0 when absent).
+
+Outputs of :func:`write_report` (in ``OUT``):
+
+- ``compare.csv``: one row per (dataset, mode, rot, trans_mm, rot_deg, planner): trials ``n``,
+  ``successes``, ``success_pct`` and the Wilson 95 % interval ``ci_lo_pct``, ``ci_hi_pct``;
+- ``compare.md``: the same as a table, one row per setting and one column per planner
+  (``success % [lo, hi] (n)``), followed by the same-drops check and the list of unreadable logs;
+- ``success_vs_noise.png``: success rate (with Wilson intervals) versus ``trans_mm`` and versus
+  ``rot_deg``, one line per planner, pooled over datasets, modes, rots and objects; each panel uses
+  the trials with the other noise term at 0 when there are any (else all trials).
+
+Same drops: a trial's drop depends only on (global seed, dataset, object, trial index), so every
+planner of one setting must show the same ``(trial, seed)`` pairs for each object. Differences are
+listed as warnings (on stderr from the CLI, and in the Markdown).
+"""
+
+import math
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import pandas as pd  # noqa: E402
+import yaml  # noqa: E402
+from mcap.reader import make_reader  # noqa: E402
+
+from graspexp.record import CorruptLogError, read_result  # noqa: E402
+from graspexp.record.schemas import METADATA_NAME  # noqa: E402
+from graspexp.report.collect import find_trial_logs  # noqa: E402
+from graspexp.report.stats import wilson_interval  # noqa: E402
+
+SETTING_KEYS: tuple[str, ...] = ("dataset", "mode", "rot")
+"""Result fields that name a setting (besides the noise level)."""
+NOISE_KEYS: tuple[str, ...] = ("trans_mm", "rot_deg")
+"""Pose-noise columns, from ``perception.noise`` in each log's config."""
+GROUP_KEYS: tuple[str, ...] = (*SETTING_KEYS, *NOISE_KEYS)
+TRIAL_KEYS: tuple[str, ...] = (*GROUP_KEYS, "planner", "object", "trial")
+
+
+def _noise(path: Path) -> tuple[float, float]:
+    """(trans_mm, rot_deg) from the log's metadata ``config_yaml``; 0 for a key the config lacks."""
+    with open(path, "rb") as f:
+        for record in make_reader(f).iter_metadata():
+            if record.name == METADATA_NAME and "config_yaml" in record.metadata:
+                cfg = yaml.safe_load(record.metadata["config_yaml"]) or {}
+                noise = ((cfg.get("perception") or {}).get("noise")) or {}
+                return float(noise.get("trans_mm", 0.0)), float(noise.get("rot_deg", 0.0))
+    raise CorruptLogError(f"{path}: no '{METADATA_NAME}' metadata record with config_yaml")
+
+
+def collect_trials(root: Path | str) -> tuple[pd.DataFrame, list[str]]:
+    """One row per readable trial log below ``root``, and one warning per unreadable or duplicate log.
+
+    Columns: dataset, mode, rot, trans_mm, rot_deg, planner, object, trial, seed, success, reason, path.
+    """
+    rows, warnings = [], []
+    for path in find_trial_logs(root):
+        try:
+            res = read_result(path)
+            trans_mm, rot_deg = _noise(path)
+        except (CorruptLogError, OSError, yaml.YAMLError) as exc:
+            warnings.append(f"unreadable log skipped: {exc}")
+            continue
+        row = {
+            k: res.get(k) for k in ("dataset", "mode", "rot", "planner", "object", "trial", "seed", "reason")
+        }
+        row.update(success=bool(res.get("success")), trans_mm=trans_mm, rot_deg=rot_deg, path=str(path))
+        rows.append(row)
+    cols = [*TRIAL_KEYS, "seed", "success", "reason", "path"]
+    df = pd.DataFrame(rows, columns=cols)
+    dup = df.duplicated(list(TRIAL_KEYS), keep="first")
+    for p in df.loc[dup, "path"]:
+        warnings.append(f"duplicate trial ignored (same planner, setting, noise, object, trial): {p}")
+    return df[~dup].reset_index(drop=True), warnings
+
+
+def success_table(df: pd.DataFrame) -> pd.DataFrame:
+    """Success per (dataset, mode, rot, trans_mm, rot_deg, planner) with Wilson 95 % bounds, in %."""
+    out = []
+    for key, g in df.groupby([*GROUP_KEYS, "planner"], sort=True):
+        n, k = len(g), int(g["success"].sum())
+        lo, hi = wilson_interval(k, n)
+        out.append(
+            {
+                **dict(zip([*GROUP_KEYS, "planner"], key, strict=True)),
+                "n": n,
+                "successes": k,
+                "success_pct": 100.0 * k / n,
+                "ci_lo_pct": 100.0 * lo,
+                "ci_hi_pct": 100.0 * hi,
+            }
+        )
+    cols = [*GROUP_KEYS, "planner", "n", "successes", "success_pct", "ci_lo_pct", "ci_hi_pct"]
+    return pd.DataFrame(out, columns=cols)
+
+
+def check_same_drops(df: pd.DataFrame) -> list[str]:
+    """Warnings where the planners of one setting did not run the same (trial, seed) pairs per object.
+
+    Empty when every planner saw the same drops (or only one planner is present).
+    """
+    warnings = []
+    for key, g in df.groupby([*GROUP_KEYS, "object"], sort=True):
+        drops = {p: frozenset(zip(s["trial"], s["seed"], strict=True)) for p, s in g.groupby("planner")}
+        if len(set(drops.values())) > 1:
+            union = frozenset().union(*drops.values())
+            detail = "; ".join(f"{p} lacks {len(union - d)}" for p, d in sorted(drops.items()) if union - d)
+            setting = ", ".join(f"{k}={v}" for k, v in zip([*GROUP_KEYS, "object"], key, strict=True))
+            warnings.append(f"different drops for {setting}: {detail} of {len(union)} (trial, seed) pairs")
+    return warnings
+
+
+def _cell(r: pd.Series) -> str:
+    return f"{r.success_pct:.0f} [{r.ci_lo_pct:.0f}, {r.ci_hi_pct:.0f}] ({r.n})"
+
+
+def render_markdown(table: pd.DataFrame, drop_warnings: list[str], other_warnings: list[str]) -> str:
+    """Markdown: settings x planners (``success % [Wilson 95 % lo, hi] (trials)``) and the checks."""
+    lines = ["# Planner comparison", ""]
+    if table.empty:
+        return "\n".join([*lines, "No readable trial logs.", ""])
+    planners = sorted(table["planner"].unique())
+    header = ["dataset", "mode", "rot", "noise trans mm", "noise rot deg", *planners]
+    lines += ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for key, g in table.groupby(list(GROUP_KEYS), sort=True):
+        cells = {r.planner: _cell(r) for r in g.itertuples()}
+        vals = [str(key[0]), str(key[1]), str(key[2]), f"{key[3]:g}", f"{key[4]:g}"]
+        lines.append("| " + " | ".join([*vals, *(cells.get(p, "-") for p in planners)]) + " |")
+    lines += ["", "Cells: success % [Wilson 95 % interval] (trials).", ""]
+    if len(planners) < 2:
+        lines.append("Same drops: only one planner present, nothing to compare.")
+    elif drop_warnings:
+        lines.append(
+            f"**Warning: the planners did not all run on the same drops** ({len(drop_warnings)} groups):"
+        )
+        lines += [f"- {w}" for w in drop_warnings]
+    else:
+        lines.append(
+            "Same drops: every planner ran the same (trial, seed) pairs for every object and setting."
+        )
+    if other_warnings:
+        lines += ["", "Other warnings:", *(f"- {w}" for w in other_warnings)]
+    return "\n".join(lines) + "\n"
+
+
+def _panel(ax, df: pd.DataFrame, key: str, other: str, unit: str) -> None:
+    sub = df[df[other] == 0] if (df[other] == 0).any() else df
+    for planner, g in sub.groupby("planner", sort=True):
+        xs, ys, lo, hi = [], [], [], []
+        for level, h in g.groupby(key, sort=True):
+            n, k = len(h), int(h["success"].sum())
+            a, b = wilson_interval(k, n)
+            xs.append(level)
+            ys.append(100.0 * k / n)
+            lo.append(100.0 * (k / n - a))
+            hi.append(100.0 * (b - k / n))
+        ax.errorbar(xs, ys, yerr=[lo, hi], marker="o", capsize=3, label=planner)
+    note = f"{other} = 0" if sub is not df else f"all {other}"
+    ax.set(
+        xlabel=f"pose noise {key} ({unit})", ylabel="success (%)", ylim=(-2, 102), title=f"vs {key} ({note})"
+    )
+    ax.grid(alpha=0.3)
+
+
+def plot_success_vs_noise(df: pd.DataFrame, path: Path | str) -> None:
+    """Two panels: success vs ``trans_mm`` and vs ``rot_deg`` per planner (module doc); PNG at ``path``."""
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
+    if not df.empty:
+        _panel(axes[0], df, "trans_mm", "rot_deg", "mm std")
+        _panel(axes[1], df, "rot_deg", "trans_mm", "deg std")
+        axes[0].legend(fontsize="small")
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def write_report(root: Path | str, out: Path | str | None = None) -> tuple[str, pd.DataFrame, list[str]]:
+    """Collect, tabulate, check and plot; write compare.md, compare.csv, success_vs_noise.png to ``out``
+    (default ``<root>/compare``). Returns (markdown, table, same-drop warnings)."""
+    root = Path(root)
+    out = Path(out) if out is not None else root / "compare"
+    df, warnings = collect_trials(root)
+    table = success_table(df)
+    drops = check_same_drops(df)
+    md = render_markdown(table, drops, warnings)
+    out.mkdir(parents=True, exist_ok=True)
+    table.to_csv(out / "compare.csv", index=False)
+    (out / "compare.md").write_text(md)
+    plot_success_vs_noise(df, out / "success_vs_noise.png")
+    for w in [*drops, *warnings]:
+        print(f"graspexp.compare: warning: {w}", file=sys.stderr)
+    return md, table, drops

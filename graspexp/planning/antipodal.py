@@ -1,0 +1,196 @@
+"""Antipodal sampling baseline (GPD / PointNetGPD style): two contacts inside each other's friction cone.
+
+Steps (cloud and normals in the world frame, metres; normals point outwards):
+
+1. seeds: ``planner.n_candidates`` cloud points drawn without replacement with
+   ``np.random.default_rng(req.seed)``, from the whole cloud (GPD knows no grasping area) or, with
+   ``planner.sample_area_only``, from the area;
+2. partner of each seed ``p1``: the cloud point ``p2`` that minimises the worse of the two cone angles
+   ``a1 = angle(v, -n1)`` and ``a2 = angle(-v, -n2)`` (``v`` unit from ``p1`` to ``p2``), among partners
+   with both angles ``<= atan(planner.friction_coef)`` and ``|p2 - p1| + 2 width_clearance_m`` within
+   the stroke; seeds without such a partner are dropped;
+3. for each pair: grasp point midway, closing axis +Y along ``v``, ``planner.n_approach`` approach
+   directions evenly spaced about ``v``, starting from the most downward one (the projection of world
+   -Z onto the plane normal to ``v``);
+4. every candidate is opened, moved back if a box would dip below the support, and checked for finger
+   and palm collisions with the cloud and the support along the straight approach
+   (:func:`graspexp.planning.collision.place_grasps`);
+5. cost = ``max(a1, a2)`` (degrees) + ``planner.approach_tilt_weight`` * the angle between the approach
+   and world -Z (degrees); the cheapest surviving candidate wins. Pairs are examined in ascending
+   ``max(a1, a2)``, which is a lower bound on their cost, so examination stops once it exceeds the best.
+
+``Grasp.n_feasible`` counts the surviving candidates among the examined pairs.
+``details``: ``pairs`` (P, 2) cloud indices, ``pair_angles_deg`` (P,), ``examined`` (number of pairs
+examined), ``best_pair`` (2,).
+"""
+
+import numpy as np
+
+from graspexp.planning.collision import frame_from_axes, max_lift_m, place_grasps
+from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
+from graspexp.planning.request import PlanRequest, PlanResult
+
+NAME = "antipodal"
+
+PAIR_BATCH = 16
+"""Contact pairs whose approaches are checked together."""
+
+
+def _check_params(req: PlanRequest) -> None:
+    pl = req.planner
+    if pl.n_candidates < 1:
+        raise ValueError(f"planner.n_candidates={pl.n_candidates!r} is invalid: expected a positive integer")
+    if pl.n_approach < 1:
+        raise ValueError(f"planner.n_approach={pl.n_approach!r} is invalid: expected a positive integer")
+    if not pl.friction_coef > 0:
+        raise ValueError(f"planner.friction_coef={pl.friction_coef!r} is invalid: expected a positive number")
+
+
+def antipodal_pairs(
+    points_m: np.ndarray,
+    normals: np.ndarray,
+    seeds: np.ndarray,
+    friction_coef: float,
+    max_distance_m: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Best antipodal partner of each seed point (step 2 of the module doc).
+
+    points_m : (N, 3) world; normals : (N, 3) outward unit; seeds : (S,) indices into points.
+
+    Returns
+    -------
+    pairs : (P, 2) int64 ``(seed, partner)`` indices, P <= S, sorted by ascending angle.
+    angles_deg : (P,) float64 worse cone angle of each pair, degrees.
+    """
+    p1, n1 = points_m[seeds], normals[seeds]
+    v = points_m[None, :, :] - p1[:, None, :]  # (S, N, 3)
+    d = np.linalg.norm(v, axis=2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        v = v / d[..., None]
+    cos1 = -np.einsum("sj,snj->sn", n1, v)  # v against the inward normal at p1
+    cos2 = np.einsum("nj,snj->sn", normals, v)  # -v against the inward normal at p2
+    worst = np.minimum(cos1, cos2)
+    cone = np.cos(np.arctan(friction_coef))
+    valid = (d > 0) & (d <= max_distance_m) & (worst >= cone)
+    worst = np.where(valid, worst, -np.inf)
+    partner = np.argmax(worst, axis=1)
+    keep = valid[np.arange(len(seeds)), partner]
+    pairs = np.stack([seeds[keep], partner[keep]], axis=1).astype(np.int64)
+    angles = np.degrees(np.arccos(np.clip(worst[keep, partner[keep]], -1.0, 1.0)))
+    order = np.argsort(angles, kind="stable")
+    return pairs[order], angles[order]
+
+
+def approaches_about(line: np.ndarray, n: int) -> np.ndarray:
+    """(n, 3) unit approach directions orthogonal to ``line``, evenly spaced, the first the most downward."""
+    v = line / np.linalg.norm(line)
+    down = np.array([0.0, 0.0, -1.0])
+    e1 = down - (down @ v) * v
+    if np.linalg.norm(e1) < 1e-6:  # vertical closing line: any horizontal start
+        e1 = np.cross(v, [1.0, 0.0, 0.0])
+        if np.linalg.norm(e1) < 1e-6:
+            e1 = np.cross(v, [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(v, e1)
+    phi = 2.0 * np.pi * np.arange(n) / n
+    return np.cos(phi)[:, None] * e1 + np.sin(phi)[:, None] * e2
+
+
+def tilt_deg(approaches: np.ndarray) -> np.ndarray:
+    """Angle between each approach (..., 3) and world -Z, degrees in [0, 180]."""
+    return np.degrees(np.arccos(np.clip(-approaches[..., 2], -1.0, 1.0)))
+
+
+def plan_antipodal(req: PlanRequest) -> PlanResult:
+    """Plan one grasp by antipodal sampling; see the module doc.
+
+    Raises
+    ------
+    NoFeasibleGrasp
+        No antipodal pair within the stroke, or every candidate collides with the cloud or the support.
+    """
+    _check_params(req)
+    pl, gr = req.planner, req.gripper
+    points = np.asarray(req.points, dtype=np.float64)
+    normals = np.asarray(req.normals, dtype=np.float64)
+    normals = normals / np.linalg.norm(normals, axis=1, keepdims=True)
+    pool = np.flatnonzero(req.area_mask) if pl.sample_area_only else np.arange(len(points))
+    if len(pool) == 0:
+        raise NoFeasibleGrasp("antipodal: no point to sample contacts from (empty grasping area)")
+    rng = np.random.default_rng(req.seed)
+    seeds = rng.choice(pool, size=min(int(pl.n_candidates), len(pool)), replace=False)
+    pairs, angles = antipodal_pairs(
+        points, normals, seeds, pl.friction_coef, gr.max_width_m - 2.0 * pl.width_clearance_m
+    )
+    if len(pairs) == 0:
+        raise NoFeasibleGrasp(
+            f"antipodal: none of {len(seeds)} sampled contacts has a partner inside the friction cone "
+            f"(mu = {pl.friction_coef}) within the stroke {gr.max_width_m} m"
+        )
+
+    best: tuple[float, int, np.ndarray, float] | None = None  # cost, pair index, pose, width
+    rejected = {"n_too_wide": 0, "n_below_support": 0, "n_collides": 0}
+    examined = n_ok = 0
+    for s in range(0, len(pairs), PAIR_BATCH):
+        if best is not None and angles[s] >= best[0]:
+            break
+        batch = range(s, min(s + PAIR_BATCH, len(pairs)))
+        poses, costs, owners = [], [], []
+        for i in batch:
+            a, b = points[pairs[i, 0]], points[pairs[i, 1]]
+            dirs = approaches_about(b - a, int(pl.n_approach))
+            centre = (a + b) / 2
+            for d in dirs:
+                poses.append(frame_from_axes(d, b - a, centre))
+            costs.append(angles[i] + pl.approach_tilt_weight * tilt_deg(dirs))
+            owners += [i] * len(dirs)
+        examined = batch.stop
+        placed = place_grasps(
+            points,
+            np.array(poses),
+            gr,
+            sweep_m=pl.sphere_radius_m,
+            table_z=req.table_z,
+            margin_m=pl.collision_margin_m,
+            clearance_m=pl.width_clearance_m,
+            max_lift_m=max_lift_m(gr),
+        )
+        for key, n in placed.counts().items():
+            rejected[key] += n
+        n_ok += int(placed.ok.sum())
+        cost = np.where(placed.ok, np.concatenate(costs), np.inf)
+        j = int(np.argmin(cost))
+        if np.isfinite(cost[j]) and (best is None or cost[j] < best[0]):
+            best = (float(cost[j]), owners[j], placed.poses[j], float(placed.widths_m[j]))
+    if best is None:
+        raise NoFeasibleGrasp(
+            f"antipodal: all {examined * int(pl.n_approach)} candidates of {len(pairs)} antipodal pairs "
+            f"failed: {rejected['n_too_wide']} too wide for the stroke, {rejected['n_below_support']} below "
+            f"the support, {rejected['n_collides']} colliding with the cloud"
+        )
+    cost, i, pose, width = best
+    grasp = Grasp(
+        pose=pose,
+        width_m=width,
+        cost=cost,
+        cluster=-1,
+        path=int(i),
+        n_feasible=n_ok,
+        planner=NAME,
+        extras={
+            "n_pairs": int(len(pairs)),
+            "n_examined": int(examined),
+            "pair_angle_deg": float(angles[i]),
+            **rejected,
+        },
+    )
+    details = {
+        "cloud": points,
+        "pairs": pairs,
+        "pair_angles_deg": angles,
+        "examined": np.int64(examined),
+        "best_pair": pairs[i],
+        "pose": pose,
+        "width": np.float64(width),
+    }
+    return PlanResult(grasp=grasp, details=details)

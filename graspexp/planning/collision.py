@@ -1,0 +1,310 @@
+"""Finger and palm volumes of a parallel gripper, checked against the object cloud and the support plane.
+
+Shared by the ``antipodal``, ``obb``, ``random`` and ``optimal_plus`` planners. Pure numpy.
+
+Geometry (the same as :mod:`graspexp.sim.gripper`), in the grasp frame (+Z approach, +Y closing axis,
+origin midway between the pads), for an opening ``w``, finger length ``L``, width ``fw`` (X), thickness
+``t`` (Y) and palm size ``(px, py, pz)``:
+
+- left finger  ``x in [-fw/2, fw/2]``, ``y in [ w/2,  w/2 + t]``, ``z in [-0.75 L, 0.25 L]``;
+- right finger ``x in [-fw/2, fw/2]``, ``y in [-w/2 - t, -w/2]``, ``z in [-0.75 L, 0.25 L]``;
+- palm         ``x in [-px/2, px/2]``, ``y in [-py/2, py/2]``, ``z in [-0.75 L - pz, -0.75 L]``.
+
+The trial moves the gripper in a straight line from the pre-grasp pose (``-sweep_m`` along +Z, where
+``sweep_m = planner.sphere_radius_m``) to the grasp pose with the fingers already open, so the volume a
+box sweeps is the same box extended by ``sweep_m`` towards -Z. A candidate collides with the cloud when
+any cloud point lies inside a swept box grown by ``margin_m`` on every side; points between the pads
+(``|y| < w/2 - margin_m``) in front of the palm are what the fingers close on and never count.
+
+Support: the lowest corner of every box, at both ends of the straight approach (the hull of the motion
+is spanned by them), must lie at or above ``table_z + margin_m``.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from graspexp.config import GripperConfig
+
+FINGER_ROOT_FRACTION = 0.75
+"""The finger roots (palm face) sit this fraction of the finger length behind the grasp point."""
+
+POSE_BATCH = 128
+"""Poses per vectorised block in :func:`cloud_hits` (bounds memory at ~POSE_BATCH x N x 3 floats)."""
+
+
+def gripper_boxes(gripper: GripperConfig, width_m: float) -> np.ndarray:
+    """(3, 2, 3) float64 ``[lo, hi]`` corners of the left finger, right finger and palm, grasp frame, m."""
+    L, fw, t = gripper.finger_length_m, gripper.finger_width_m, gripper.finger_thickness_m
+    px, py, pz = (float(v) for v in gripper.palm_size_m)
+    root = -FINGER_ROOT_FRACTION * L
+    tip = root + L
+    h = width_m / 2
+    return np.array(
+        [
+            [[-fw / 2, h, root], [fw / 2, h + t, tip]],
+            [[-fw / 2, -h - t, root], [fw / 2, -h, tip]],
+            [[-px / 2, -py / 2, root - pz], [px / 2, py / 2, root]],
+        ]
+    )
+
+
+def fingertip_z_offset_m(gripper: GripperConfig) -> float:
+    """How far the fingertips reach past the grasp point along +Z, m (``0.25 L``)."""
+    return (1.0 - FINGER_ROOT_FRACTION) * gripper.finger_length_m
+
+
+def lowest_z(poses: np.ndarray, gripper: GripperConfig, widths_m: np.ndarray, sweep_m: float) -> np.ndarray:
+    """Lowest world z reached by any gripper box during the approach, for a batch of grasps.
+
+    poses : (B, 4, 4) grasp poses, world; widths_m : (B,) openings, m; sweep_m : approach length, m.
+
+    Returns
+    -------
+    (B,) float64, world z, metres.
+    """
+    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)
+    widths = np.broadcast_to(np.asarray(widths_m, dtype=np.float64), (len(poses),))
+    out = np.empty(len(poses))
+    pick = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])  # 8 corners: lo/hi per axis
+    back = np.array([0.0, 0.0, sweep_m])
+    for b, (pose, w) in enumerate(zip(poses, widths, strict=True)):
+        boxes = gripper_boxes(gripper, float(w))  # (3, 2, 3)
+        corners = boxes[:, pick, np.arange(3)].reshape(-1, 3)  # (24, 3) grasp frame
+        ends = np.concatenate([corners, corners - back])  # grasp and pre-grasp ends of the approach
+        out[b] = float((ends @ pose[:3, :3].T + pose[:3, 3])[:, 2].min())
+    return out
+
+
+def local_coords(points_m: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """(B, N, 3) coordinates of world points (N, 3) in each grasp frame of (B, 4, 4) poses."""
+    p = np.asarray(points_m, dtype=np.float64)
+    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)
+    rel = p[None, :, :] - poses[:, None, :3, 3]
+    return np.einsum("bni,bij->bnj", rel, poses[:, :3, :3])
+
+
+def closing_section(
+    local: np.ndarray, gripper: GripperConfig, margin_m: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Range of ``y`` over the points in the pads' reach: what the fingers must close around.
+
+    local : (B, N, 3) points in each grasp frame. A point is in reach when ``|x| <= fw/2 + margin`` and
+    ``z`` lies within the finger span (module doc) grown by ``margin``.
+
+    Returns
+    -------
+    lo, hi : (B,) float64, metres; both 0 where no point is in reach.
+    """
+    L, fw = gripper.finger_length_m, gripper.finger_width_m
+    root = -FINGER_ROOT_FRACTION * L
+    x, y, z = local[..., 0], local[..., 1], local[..., 2]
+    reach = (np.abs(x) <= fw / 2 + margin_m) & (z >= root - margin_m) & (z <= root + L + margin_m)
+    hi = np.where(reach, y, -np.inf).max(axis=1)
+    lo = np.where(reach, y, np.inf).min(axis=1)
+    some = reach.any(axis=1)
+    return np.where(some, lo, 0.0), np.where(some, hi, 0.0)
+
+
+def cloud_hits(
+    points_m: np.ndarray,
+    poses: np.ndarray,
+    gripper: GripperConfig,
+    widths_m: np.ndarray,
+    *,
+    sweep_m: float,
+    margin_m: float,
+) -> np.ndarray:
+    """Number of cloud points inside the swept finger and palm boxes (module doc), per grasp.
+
+    points_m : (N, 3) world; poses : (B, 4, 4) world; widths_m : (B,) or scalar openings, m.
+
+    Returns
+    -------
+    (B,) int64; 0 means collision-free.
+    """
+    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)
+    widths = np.broadcast_to(np.asarray(widths_m, dtype=np.float64), (len(poses),))
+    out = np.zeros(len(poses), dtype=np.int64)
+    L, fw, t = gripper.finger_length_m, gripper.finger_width_m, gripper.finger_thickness_m
+    px, py, pz = (float(v) for v in gripper.palm_size_m)
+    root = -FINGER_ROOT_FRACTION * L
+    m = margin_m
+    for s in range(0, len(poses), POSE_BATCH):
+        local = local_coords(points_m, poses[s : s + POSE_BATCH])
+        x, y, z = local[..., 0], local[..., 1], local[..., 2]
+        h = widths[s : s + POSE_BATCH, None] / 2
+        ay = np.abs(y)
+        fingers = (
+            (np.abs(x) <= fw / 2 + m)
+            & (z >= root - sweep_m - m)
+            & (z <= root + L + m)
+            & (ay >= h - m)
+            & (ay <= h + t + m)
+        )
+        palm = (
+            (np.abs(x) <= px / 2 + m) & (ay <= py / 2 + m) & (z >= root - pz - sweep_m - m) & (z <= root + m)
+        )
+        out[s : s + POSE_BATCH] = (fingers | palm).sum(axis=1)
+    return out
+
+
+def support_lift_m(
+    poses: np.ndarray,
+    gripper: GripperConfig,
+    widths_m: np.ndarray,
+    *,
+    sweep_m: float,
+    table_z: float,
+    margin_m: float,
+) -> np.ndarray:
+    """How far each grasp must move back along -Z (away from the object) to clear the support, m.
+
+    0 where the lowest box corner is already at or above ``table_z + margin_m``; ``inf`` where moving
+    back cannot help (an approach that does not point downwards).
+
+    Returns
+    -------
+    (B,) float64, metres.
+    """
+    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)
+    deficit = table_z + margin_m - lowest_z(poses, gripper, widths_m, sweep_m)
+    down = -poses[:, 2, 2]  # how much world height one metre back along -Z gains
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lift = np.where(deficit <= 0, 0.0, np.where(down > 1e-9, deficit / down, np.inf))
+    return lift
+
+
+def frame_from_axes(approach: np.ndarray, closing: np.ndarray, origin: np.ndarray) -> np.ndarray:
+    """(4,4) grasp pose with +Z = ``approach``, +Y = ``closing`` made orthogonal to it, +X = Y x Z.
+
+    approach, closing : (3,) non-parallel vectors (normalised here); origin : (3,) world, m. The rotation
+    is orthonormal with det +1 (X = Y x Z makes the triad right-handed: Y = Z x X).
+    """
+    z = np.asarray(approach, dtype=np.float64)
+    z = z / np.linalg.norm(z)
+    y = np.asarray(closing, dtype=np.float64)
+    y = y - (y @ z) * z
+    y = y / np.linalg.norm(y)
+    x = np.cross(y, z)
+    pose = np.eye(4)
+    pose[:3, :3] = np.stack([x, y, z], axis=1)
+    pose[:3, 3] = origin
+    return pose
+
+
+@dataclass(frozen=True)
+class Placement:
+    """Candidate grasps after :func:`place_grasps`.
+
+    poses : (B, 4, 4) world poses, centred on the section along +Y and moved back along -Z where the
+        support required it.
+    widths_m : (B,) openings, m (clipped to the stroke; meaningful where ``ok``).
+    lift_m : (B,) how far each grasp was moved back, m (inf: could not clear the support).
+    ok : (B,) bool, True where the grasp fits the stroke, clears the support and hits no cloud point.
+    too_wide, below_support, collides : (B,) bool, the first failed check of each rejected candidate.
+    """
+
+    poses: np.ndarray
+    widths_m: np.ndarray
+    lift_m: np.ndarray
+    ok: np.ndarray
+    too_wide: np.ndarray
+    below_support: np.ndarray
+    collides: np.ndarray
+
+    def counts(self) -> dict[str, int]:
+        """Rejections per check, for messages and ``Grasp.extras``."""
+        return {
+            "n_too_wide": int(self.too_wide.sum()),
+            "n_below_support": int(self.below_support.sum()),
+            "n_collides": int(self.collides.sum()),
+        }
+
+
+def place_grasps(
+    points_m: np.ndarray,
+    poses: np.ndarray,
+    gripper: GripperConfig,
+    *,
+    sweep_m: float,
+    table_z: float,
+    margin_m: float,
+    clearance_m: float,
+    max_lift_m: float,
+    min_widths_m: np.ndarray | float = 0.0,
+) -> Placement:
+    """Open, lift and check a batch of candidate grasps against the cloud and the support.
+
+    1. centre: each grasp point moves along +Y to the middle of the object's section between the pads
+       (:func:`closing_section`; the pads close symmetrically about the grasp point, so an off-centre
+       point would need a needlessly wide opening); opening = ``max(min_widths_m, section + 2
+       clearance_m)``, at least ``gripper.min_width_m``;
+    2. move the grasp back along -Z by :func:`support_lift_m` (at most ``max_lift_m``, else rejected as
+       below the support), then re-centre and recompute the opening there;
+    3. reject when the opening exceeds ``gripper.max_width_m`` (too wide), when a box still dips below
+       ``table_z + margin_m`` (below support), or when :func:`cloud_hits` finds a point (collides).
+
+    points_m : (N, 3) world cloud; poses : (B, 4, 4) world candidate poses.
+    """
+    poses = np.array(poses, dtype=np.float64).reshape(-1, 4, 4)
+    b = len(poses)
+    floor = np.maximum(np.broadcast_to(np.asarray(min_widths_m, dtype=np.float64), (b,)), gripper.min_width_m)
+
+    def centre_and_open(ps: np.ndarray, fl: np.ndarray) -> np.ndarray:
+        """Shift each pose along its +Y to the middle of its section (in place); return the openings."""
+        out = np.empty(len(ps))
+        for s in range(0, len(ps), POSE_BATCH):
+            blk = ps[s : s + POSE_BATCH]
+            lo, hi = closing_section(local_coords(points_m, blk), gripper, margin_m)
+            blk[:, :3, 3] += ((lo + hi) / 2)[:, None] * blk[:, :3, 1]
+            out[s : s + POSE_BATCH] = hi - lo
+        return np.maximum(out + 2.0 * clearance_m, fl)
+
+    widths = centre_and_open(poses, floor)
+    lift = support_lift_m(
+        poses,
+        gripper,
+        np.minimum(widths, gripper.max_width_m),
+        sweep_m=sweep_m,
+        table_z=table_z,
+        margin_m=margin_m,
+    )
+    lift = np.where(lift <= max_lift_m, lift, np.inf)
+    movable = np.isfinite(lift)
+    poses[movable, :3, 3] -= lift[movable, None] * poses[movable, :3, 2]
+    moved = movable & (lift > 0)
+    if moved.any():
+        sub = poses[moved]
+        widths[moved] = centre_and_open(sub, floor[moved])
+        poses[moved] = sub
+    too_wide = widths > gripper.max_width_m + 1e-12
+    widths = np.minimum(widths, gripper.max_width_m)
+    low = lowest_z(poses, gripper, widths, sweep_m) < table_z + margin_m - 1e-9
+    below = ~too_wide & (~movable | low)
+    check = ~too_wide & ~below
+    hits = np.zeros(b, dtype=np.int64)
+    if check.any():
+        hits[check] = cloud_hits(
+            points_m, poses[check], gripper, widths[check], sweep_m=sweep_m, margin_m=margin_m
+        )
+    collides = check & (hits > 0)
+    return Placement(
+        poses=poses,
+        widths_m=widths,
+        lift_m=lift,
+        ok=check & ~collides,
+        too_wide=too_wide,
+        below_support=below,
+        collides=collides,
+    )
+
+
+MAX_LIFT_FRACTION = 0.8
+"""A grasp may move back from its grasp point by at most this fraction of the fingertip reach
+(``0.25 L``), so the point it aimed at stays between the pads."""
+
+
+def max_lift_m(gripper: GripperConfig) -> float:
+    """Largest back-off along -Z that :func:`place_grasps` may apply to clear the support, m."""
+    return MAX_LIFT_FRACTION * fingertip_z_offset_m(gripper)

@@ -1,0 +1,183 @@
+"""``optimal_plus``: the paper's planner (:mod:`.optimal`) with three general weaknesses fixed.
+
+Same grasping area, main axis, K-means clusters, Fibonacci-sphere paths, support-plane test and cost
+Eq. (1)-(3) as ``optimal`` (its building blocks are reused unchanged). Then:
+
+1. **Centre-of-mass preference.** Each cluster's costs are multiplied by
+   ``1 + planner.com_weight * |c_k - g| / D``, where ``g`` is the centroid of the cloud (the centre of
+   mass of a uniform shell, the best estimate a surface cloud gives) and ``D`` the diagonal of the
+   cloud's axis-aligned box, m/m. A grasp near the centre of mass resists the gravity torque that
+   makes off-centre grasps rotate and slip once the support goes (collab) or during the lift (bin).
+2. **Opening from the geometry, not only from r_k.** The opening is
+   ``max(2 r_k (1 + width_margin), 2 max|y| + 2 planner.width_clearance_m)`` where ``max|y|`` is the
+   largest distance from the closing plane of any cloud point in the fingers' reach (x within the
+   finger width, z within the finger span); ``2 r_k`` under-estimates the section of round or
+   elongated clusters, so the paper's opening can land a finger on the object. Above the stroke, the
+   path is rejected.
+3. **Swept-volume collision check.** Each path is checked, in ascending cost, with the finger and palm
+   boxes swept along the straight approach against the cloud and against the support plane
+   (:func:`graspexp.planning.collision.place_grasps`; a grasp whose boxes would dip below the plane is
+   first moved back along the approach, by at most 80 % of the fingertip reach). The paper only tests
+   the path's start point against the plane, so the palm can hit the object (e.g. a tall object
+   grasped low from above) and the fingertips the table.
+
+The cheapest path that passes wins. ``Grasp.n_feasible`` counts the passing paths among those examined
+(examination stops at the first pass after a batch). ``details`` holds the same keys as ``optimal``
+where they apply (``cloud``, ``area_mask``, ``labels``, ``centers``, ``radii``, ``main_axis``,
+``directions``, ``costs`` (K, M; inf where removed by the plane test), ``best``, ``pose``, ``width``)
+plus ``com`` (3,) and ``com_factor`` (K,).
+"""
+
+import numpy as np
+
+from graspexp.planning.clusters import choose_k, main_axis, segment
+from graspexp.planning.collision import max_lift_m, place_grasps
+from graspexp.planning.cost import cluster_costs
+from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
+from graspexp.planning.optimal import kmeans_random_state
+from graspexp.planning.paths import above_support, approach_directions
+from graspexp.planning.pose import grasp_rotations, opening_width_m
+from graspexp.planning.request import PlanRequest, PlanResult
+
+NAME = "optimal_plus"
+
+PATH_BATCH = 32
+"""Paths checked together, in ascending cost."""
+
+
+def com_factors(
+    centers_m: np.ndarray, points_m: np.ndarray, com_weight: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Cost factors ``1 + w |c_k - g| / D`` (fix 1 of the module doc) and the centroid ``g`` (3,)."""
+    g = points_m.mean(axis=0)
+    size = float(np.linalg.norm(points_m.max(axis=0) - points_m.min(axis=0)))
+    dist = np.linalg.norm(centers_m - g, axis=1)
+    return 1.0 + com_weight * dist / max(size, 1e-9), g
+
+
+def plan_optimal_plus(req: PlanRequest) -> PlanResult:
+    """Plan one grasp with the paper's strategy plus the fixes of the module doc.
+
+    Raises
+    ------
+    NoFeasibleGrasp
+        Empty grasping area; every path crosses the support plane; or every remaining path is too wide,
+        below the support or colliding with the cloud.
+    """
+    pl, gr = req.planner, req.gripper
+    if pl.com_weight < 0:
+        raise ValueError(f"planner.com_weight={pl.com_weight!r} is invalid: expected a non-negative number")
+    points = np.asarray(req.points, dtype=np.float64)
+    mask = np.asarray(req.area_mask, dtype=bool)
+    if req.mode not in ("collab", "bin"):
+        raise ValueError(f"mode={req.mode!r} is invalid: expected one of collab, bin")
+    area = points[mask]
+    if len(area) == 0:
+        raise NoFeasibleGrasp(
+            "optimal_plus: the grasping area is empty: no point of the cloud is in area_mask"
+        )
+
+    axis = main_axis(area)
+    k = choose_k(pl.k, pl.k_max, area, axis, gr.max_width_m)
+    clusters = segment(area, k, random_state=kmeans_random_state(req.seed, pl.seed))
+    centers, radii = clusters.centers_m, clusters.radii_m
+    k, m = len(centers), int(pl.m)
+    directions = approach_directions(centers, m)
+    feasible = above_support(centers, directions, pl.sphere_radius_m, req.table_z, pl.table_clearance_m)
+    if not feasible.any():
+        raise NoFeasibleGrasp(
+            f"optimal_plus: every one of the {k * m} paths starts below the support plane z = "
+            f"{req.table_z + pl.table_clearance_m:.4f} m (sphere radius {pl.sphere_radius_m} m)"
+        )
+    factors, com = com_factors(centers, points, pl.com_weight)
+    costs = np.full((k, m), np.inf)
+    for j in range(k):
+        ok = feasible[j]
+        if ok.any():
+            costs[j, ok] = factors[j] * cluster_costs(
+                points,
+                centers[j],
+                radii[j],
+                directions[j, ok],
+                axis,
+                req.mode,
+                req.table_z,
+                gr.max_width_m,
+                req.cost,
+            )
+    openings = np.array([opening_width_m(float(r), pl.width_margin, gr) for r in radii])
+
+    order = np.argsort(costs, axis=None, kind="stable")[: int(feasible.sum())]
+    rejected = {"n_too_wide": 0, "n_below_support": 0, "n_collides": 0}
+    best = None
+    n_ok = examined = 0
+    for s in range(0, len(order), PATH_BATCH):
+        ks, ps = np.unravel_index(order[s : s + PATH_BATCH], (k, m))
+        poses = np.tile(np.eye(4), (len(ks), 1, 1))
+        poses[:, :3, :3] = grasp_rotations(directions[ks, ps], axis)
+        poses[:, :3, 3] = centers[ks]
+        placed = place_grasps(
+            points,
+            poses,
+            gr,
+            sweep_m=pl.sphere_radius_m,
+            table_z=req.table_z,
+            margin_m=pl.collision_margin_m,
+            clearance_m=pl.width_clearance_m,
+            max_lift_m=max_lift_m(gr),
+            min_widths_m=openings[ks],
+        )
+        examined += len(ks)
+        for key, n in placed.counts().items():
+            rejected[key] += n
+        n_ok += int(placed.ok.sum())
+        if placed.ok.any():
+            j = int(np.argmax(placed.ok))  # the batch is in ascending cost
+            best = (
+                int(ks[j]),
+                int(ps[j]),
+                placed.poses[j],
+                float(placed.widths_m[j]),
+                float(placed.lift_m[j]),
+            )
+            break
+    if best is None:
+        raise NoFeasibleGrasp(
+            f"optimal_plus: all {examined} paths above the support failed: {rejected['n_too_wide']} too "
+            f"wide for the stroke {gr.max_width_m} m, {rejected['n_below_support']} below the support, "
+            f"{rejected['n_collides']} with fingers or palm colliding with the cloud"
+        )
+    kb, pb, pose, width, lift = best
+    grasp = Grasp(
+        pose=pose,
+        width_m=width,
+        cost=float(costs[kb, pb]),
+        cluster=kb,
+        path=pb,
+        n_feasible=n_ok,
+        planner=NAME,
+        extras={
+            "K": k,
+            "M": m,
+            "n_examined": examined,
+            "lift_m": lift,
+            "com_factor": float(factors[kb]),
+            **rejected,
+        },
+    )
+    details = {
+        "cloud": points,
+        "area_mask": mask,
+        "labels": clusters.labels,
+        "centers": centers,
+        "radii": radii,
+        "main_axis": axis,
+        "directions": directions,
+        "costs": costs,
+        "com": com,
+        "com_factor": factors,
+        "best": np.array([kb, pb]),
+        "pose": pose,
+        "width": np.float64(width),
+    }
+    return PlanResult(grasp=grasp, details=details)

@@ -1,0 +1,193 @@
+"""Baseline planners (antipodal, obb, random) and optimal_plus: the planner contract on synthetic clouds
+and one primitive, the shared finger/palm collision checks, determinism and NoFeasibleGrasp."""
+
+import numpy as np
+import pytest
+import trimesh
+from omegaconf import OmegaConf
+
+from graspexp.cli import compose_config
+from graspexp.planning import NoFeasibleGrasp, PlanRequest, get_planner, plan
+from graspexp.planning.collision import cloud_hits, frame_from_axes, gripper_boxes, lowest_z
+
+MINE = ("antipodal", "obb", "random", "optimal_plus")
+TABLE_Z = 0.1
+
+
+def _cfg(planner: str, mode: str = "bin", *extra: str):
+    return OmegaConf.to_object(compose_config([f"planner={planner}", f"mode={mode}", *extra]))
+
+
+def _cloud(mesh: trimesh.Trimesh, n: int = 1024, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Surface samples resting on the table (lowest point at TABLE_Z) and their outward normals."""
+    pts, faces = trimesh.sample.sample_surface_even(mesh, n, seed=seed)
+    pts = pts + np.array([0.0, 0.0, TABLE_Z - mesh.bounds[0, 2]])
+    return pts, mesh.face_normals[faces]
+
+
+def _request(planner: str, pts, normals, mode: str = "bin", seed: int = 3, area=None) -> PlanRequest:
+    cfg = _cfg(planner, mode)
+    mask = np.ones(len(pts), bool) if area is None else area
+    return PlanRequest(pts, normals, mask, np.eye(4), TABLE_Z, mode, cfg.gripper, cfg.planner, cfg.cost, seed)
+
+
+def _shapes() -> dict[str, trimesh.Trimesh]:
+    tilted = trimesh.creation.box((0.04, 0.07, 0.09))
+    tilted.apply_transform(trimesh.transformations.rotation_matrix(0.5, [1, 1, 0]))
+    return {
+        "box": trimesh.creation.box((0.05, 0.08, 0.12)),
+        "cylinder": trimesh.creation.cylinder(radius=0.03, height=0.10),
+        "flat": trimesh.creation.box((0.09, 0.06, 0.02)),
+        "tilted": tilted,
+    }
+
+
+def _check_contract(req: PlanRequest, name: str) -> None:
+    g = plan(req).grasp
+    R = g.pose[:3, :3]
+    assert g.planner == name
+    np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-9)
+    assert np.linalg.det(R) == pytest.approx(1.0, abs=1e-9)
+    np.testing.assert_allclose(g.pose[3], [0, 0, 0, 1])
+    gr, pl = req.gripper, req.planner
+    assert gr.min_width_m <= g.width_m <= gr.max_width_m
+    pre = g.position - pl.sphere_radius_m * g.approach
+    assert pre[2] >= req.table_z
+    # fingertip corners, computed here from the gripper dimensions rather than collision.py
+    X, Y, Z = R.T
+    tip = g.position + 0.25 * gr.finger_length_m * Z
+    for sy in (1, -1):
+        for side in (g.width_m / 2, g.width_m / 2 + gr.finger_thickness_m):
+            for sx in (1, -1):
+                corner = tip + sy * side * Y + sx * gr.finger_width_m / 2 * X
+                assert corner[2] >= req.table_z - 1e-9, (name, corner)
+
+
+@pytest.mark.parametrize("name", MINE)
+@pytest.mark.parametrize("shape", ["box", "cylinder", "flat", "tilted"])
+@pytest.mark.parametrize("mode", ["bin", "collab"])
+def test_contract_on_synthetic_clouds(name: str, shape: str, mode: str) -> None:
+    pts, normals = _cloud(_shapes()[shape])
+    _check_contract(_request(name, pts, normals, mode), name)
+
+
+@pytest.mark.parametrize("name", MINE)
+def test_contract_on_a_primitive(name: str) -> None:
+    from graspexp.datasets import load_object
+
+    cfg = _cfg(name, "bin", "dataset=primitives")
+    model = load_object(cfg.dataset, "mug", 1024, 0)
+    pose = np.eye(4)
+    pose[:3, :3] = trimesh.transformations.rotation_matrix(1.1, [0.3, 1, 0.2])[:3, :3]
+    pts = model.points @ pose[:3, :3].T
+    pose[2, 3] = TABLE_Z - pts[:, 2].min()
+    req = PlanRequest(
+        pts + pose[:3, 3],
+        model.normals @ pose[:3, :3].T,
+        model.area_mask,
+        pose,
+        TABLE_Z,
+        "bin",
+        cfg.gripper,
+        cfg.planner,
+        cfg.cost,
+        11,
+    )
+    _check_contract(req, name)
+
+
+@pytest.mark.parametrize("name", MINE)
+def test_deterministic_given_the_seed(name: str) -> None:
+    pts, normals = _cloud(_shapes()["tilted"])
+    a = plan(_request(name, pts, normals, seed=5)).grasp
+    b = plan(_request(name, pts, normals, seed=5)).grasp
+    np.testing.assert_array_equal(a.pose, b.pose)
+    assert a.width_m == b.width_m
+
+
+def test_random_depends_on_the_seed() -> None:
+    pts, normals = _cloud(_shapes()["box"])
+    poses = {plan(_request("random", pts, normals, seed=s)).grasp.pose.tobytes() for s in range(4)}
+    assert len(poses) == 4
+
+
+@pytest.mark.parametrize("name", ["antipodal", "obb", "optimal_plus"])
+def test_object_wider_than_the_stroke_is_infeasible(name: str) -> None:
+    pts, normals = _cloud(trimesh.creation.box((0.3, 0.3, 0.3)))
+    with pytest.raises(NoFeasibleGrasp, match=name.split("_")[0]):
+        plan(_request(name, pts, normals))
+
+
+def test_random_with_empty_area_is_infeasible() -> None:
+    pts, normals = _cloud(_shapes()["box"])
+    with pytest.raises(NoFeasibleGrasp, match="area is empty"):
+        plan(_request("random", pts, normals, area=np.zeros(len(pts), bool)))
+
+
+def test_antipodal_closes_across_opposite_faces() -> None:
+    pts, normals = _cloud(_shapes()["box"], n=2048)
+    g = plan(_request("antipodal", pts, normals)).grasp
+    y = g.pose[:3, 1]
+    assert np.max(np.abs(y)) == pytest.approx(1.0, abs=0.03)  # along a face normal of the axis box
+    assert g.extras["pair_angle_deg"] < 10.0
+    assert g.approach[2] < -0.9  # top-down preferred on a box standing on the table
+    assert (
+        cloud_hits(pts, g.pose[None], _cfg("antipodal").gripper, g.width_m, sweep_m=0.1, margin_m=0.0)[0] == 0
+    )
+
+
+def test_obb_closes_across_the_narrow_side_from_above() -> None:
+    box = trimesh.creation.box((0.09, 0.05, 0.06))
+    box.apply_transform(trimesh.transformations.rotation_matrix(0.6, [0, 0, 1]))
+    pts, normals = _cloud(box)
+    g = plan(_request("obb", pts, normals)).grasp
+    np.testing.assert_allclose(g.approach, [0, 0, -1], atol=1e-9)
+    narrow = np.array([-np.sin(0.6), np.cos(0.6), 0.0])
+    assert abs(g.pose[:3, 1] @ narrow) == pytest.approx(1.0, abs=1e-3)
+    assert g.width_m == pytest.approx(0.05 + 2 * 0.005, abs=2e-3)
+
+
+def test_optimal_plus_avoids_the_palm_collision_that_optimal_accepts() -> None:
+    # A tall narrow object: the paper's planner grasps its cluster centres from above, with the palm in the
+    # object; optimal_plus must return a grasp whose swept fingers and palm touch no cloud point.
+    pts, normals = _cloud(trimesh.creation.box((0.04, 0.04, 0.2)), n=2048)
+    gr = _cfg("optimal").gripper
+    hits = {}
+    for name in ("optimal", "optimal_plus"):
+        g = plan(_request(name, pts, normals)).grasp
+        hits[name] = cloud_hits(pts, g.pose[None], gr, g.width_m, sweep_m=0.1, margin_m=0.0)[0]
+    assert hits["optimal"] > 0
+    assert hits["optimal_plus"] == 0
+
+
+def test_cloud_hits_counts_points_in_fingers_and_palm_only() -> None:
+    gr = _cfg("obb").gripper
+    pose = frame_from_axes([0, 0, -1], [0, 1, 0], [0, 0, 0.2])
+    L, w = gr.finger_length_m, 0.06
+    local = np.array(
+        [
+            [0.0, 0.0, 0.0],  # between the pads
+            [0.0, w / 2 + gr.finger_thickness_m / 2, 0.0],  # inside the left finger
+            [0.0, 0.0, -0.75 * L - 0.01],  # inside the palm
+            [0.0, 0.0, -0.75 * L - gr.palm_size_m[2] - 0.05],  # swept by the palm on the approach
+            [0.0, 0.2, 0.0],  # far out along +Y
+        ]
+    )
+    world = local @ pose[:3, :3].T + pose[:3, 3]
+    per_point = [cloud_hits(p[None], pose[None], gr, w, sweep_m=0.1, margin_m=0.0)[0] for p in world]
+    assert per_point == [0, 1, 1, 1, 0]
+    assert cloud_hits(world, pose[None], gr, w, sweep_m=0.0, margin_m=0.0)[0] == 2  # no sweep: 2 hits
+
+
+def test_lowest_z_of_a_top_down_grasp_is_the_fingertip() -> None:
+    gr = _cfg("obb").gripper
+    pose = frame_from_axes([0, 0, -1], [0, 1, 0], [0, 0, 0.2])
+    assert lowest_z(pose[None], gr, 0.05, 0.1)[0] == pytest.approx(0.2 - 0.25 * gr.finger_length_m)
+    boxes = gripper_boxes(gr, 0.05)
+    assert boxes[0, 0, 1] == pytest.approx(0.025) and boxes[1, 1, 1] == pytest.approx(-0.025)
+
+
+def test_every_planner_is_registered_and_composes() -> None:
+    for name in MINE:
+        assert get_planner(name).__name__.startswith("plan_")
+        assert _cfg(name).planner.name == name
