@@ -18,7 +18,7 @@ def _cfg(planner: str, mode: str = "bin", *extra: str):
     return OmegaConf.to_object(compose_config([f"planner={planner}", f"mode={mode}", *extra]))
 
 
-def _cloud(mesh: trimesh.Trimesh, n: int = 1024, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+def _cloud(mesh: trimesh.Trimesh, n: int = 768, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Surface samples resting on the table (lowest point at TABLE_Z) and their outward normals."""
     pts, faces = trimesh.sample.sample_surface_even(mesh, n, seed=seed)
     pts = pts + np.array([0.0, 0.0, TABLE_Z - mesh.bounds[0, 2]])
@@ -64,8 +64,9 @@ def _check_contract(req: PlanRequest, name: str) -> None:
 
 
 @pytest.mark.parametrize("name", MINE)
-@pytest.mark.parametrize("shape", ["box", "cylinder", "flat", "tilted"])
-@pytest.mark.parametrize("mode", ["bin", "collab"])
+@pytest.mark.parametrize(
+    ("shape", "mode"), [("box", "bin"), ("cylinder", "collab"), ("flat", "bin"), ("tilted", "collab")]
+)
 def test_contract_on_synthetic_clouds(name: str, shape: str, mode: str) -> None:
     pts, normals = _cloud(_shapes()[shape])
     _check_contract(_request(name, pts, normals, mode), name)
@@ -148,14 +149,22 @@ def test_obb_closes_across_the_narrow_side_from_above() -> None:
 
 
 def test_optimal_plus_avoids_the_palm_collision_that_optimal_accepts() -> None:
-    # A tall narrow object: the paper's planner grasps its cluster centres from above, with the palm in the
-    # object; optimal_plus must return a grasp whose swept fingers and palm touch no cloud point.
-    pts, normals = _cloud(trimesh.creation.box((0.04, 0.04, 0.2)), n=2048)
-    gr = _cfg("optimal").gripper
+    # The upright primitive can (66 x 100 mm), bin mode: the paper's planner grasps a cluster centre about
+    # half-way up from nearly straight above, so the palm (0.75 L behind the grasp point) is inside the
+    # can; optimal_plus must return a grasp whose swept fingers and palm touch no cloud point.
+    from graspexp.datasets import load_object
+
+    cfg = _cfg("optimal", "bin", "dataset=primitives")
+    model = load_object(cfg.dataset, "can", 2048, 0)
+    pts = model.points + np.array([0.0, 0.0, TABLE_Z - model.points[:, 2].min()])
     hits = {}
     for name in ("optimal", "optimal_plus"):
-        g = plan(_request(name, pts, normals)).grasp
-        hits[name] = cloud_hits(pts, g.pose[None], gr, g.width_m, sweep_m=0.1, margin_m=0.0)[0]
+        c = _cfg(name, "bin", "dataset=primitives")
+        req = PlanRequest(
+            pts, model.normals, model.area_mask, np.eye(4), TABLE_Z, "bin", c.gripper, c.planner, c.cost, 1
+        )
+        g = plan(req).grasp
+        hits[name] = cloud_hits(pts, g.pose[None], cfg.gripper, g.width_m, sweep_m=0.1, margin_m=0.0)[0]
     assert hits["optimal"] > 0
     assert hits["optimal_plus"] == 0
 

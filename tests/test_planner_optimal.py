@@ -177,19 +177,31 @@ def test_paths_found_too_wide_are_skipped_for_the_next_cheapest():
 
 
 def test_a_band_shorter_than_its_diameter_is_closed_across_not_along_its_height():
-    # A 66 mm can whose area is a 40 mm band: PCA puts the main axis horizontal, so a horizontal
+    # A 66 mm can whose area is a 40 mm band, main axis from the area (planner.main_axis=area): PCA puts
+    # the main axis horizontal, so a horizontal
     # approach would close the fingers along the can's height (100 mm section) with a ~75 mm opening.
     # That section does not fit the r_k opening; the planner goes on to a path whose section does.
     rng = np.random.default_rng(8)
     pts = cylinder_cloud(rng, 2048, radius_m=0.033, height_m=0.10) + [0.0, 0.0, 0.1]
     mask = (pts[:, 2] > 0.13) & (pts[:, 2] < 0.17)
-    req = request(pts, mask, table_z=0.1, planner=PlannerConfig(name="optimal"))
+    req = request(pts, mask, table_z=0.1, planner=PlannerConfig(name="optimal", main_axis="area"))
     res = plan_optimal(req)
     _check_result(res, req)
     assert abs(res.details["main_axis"][2]) < 0.3
     assert abs(res.grasp.pose[2, 1]) < 0.3  # closing axis Y is (nearly) horizontal
     assert res.grasp.extras["slab_extent_m"] < 0.075
     assert res.grasp.extras["n_too_wide"] > 0 and not res.grasp.extras["widened"]
+
+
+def test_object_main_axis_of_a_can_is_its_height():
+    # planner.main_axis=object (default): the whole can's first principal component is its axis, even
+    # when the grasping area is a short band; the fingers then close across the can.
+    rng = np.random.default_rng(8)
+    pts = cylinder_cloud(rng, 2048, radius_m=0.033, height_m=0.10) + [0.0, 0.0, 0.1]
+    mask = (pts[:, 2] > 0.13) & (pts[:, 2] < 0.17)
+    res = plan_optimal(request(pts, mask, table_z=0.1, planner=PlannerConfig(name="optimal")))
+    assert abs(res.details["main_axis"][2]) > 0.95
+    assert abs(res.grasp.pose[2, 1]) < 0.3
 
 
 def test_opening_is_widened_when_no_section_fits_the_cluster_radius():

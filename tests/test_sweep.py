@@ -58,8 +58,8 @@ def joblib_sweep(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def test_joblib_multirun_runs_each_setting_into_its_own_dir(joblib_sweep: Path) -> None:
     subdirs = sorted(p.name for p in joblib_sweep.iterdir() if p.is_dir())
     assert subdirs == [
-        "dataset=primitives,mode=bin,objects=[can,box],progress=False,rot=z,trials=3",
-        "dataset=primitives,mode=collab,objects=[can,box],progress=False,rot=z,trials=3",
+        "dataset=primitives,mode=bin,objects=[can,box],rot=z,trials=3",
+        "dataset=primitives,mode=collab,objects=[can,box],rot=z,trials=3",
     ]
     assert len(_logs(joblib_sweep)) == N_TRIALS
     table = _table(joblib_sweep)
