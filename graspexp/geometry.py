@@ -53,9 +53,10 @@ def matrix_to_quat_wxyz(R: np.ndarray) -> np.ndarray:
     return q if q[0] >= 0 else -q
 
 
-def wxyz_to_xyzw(q: np.ndarray) -> np.ndarray:
-    """SAPIEN order (w, x, y, z) -> Foxglove order (x, y, z, w)."""
-    return np.asarray([q[1], q[2], q[3], q[0]], dtype=float)
+def wxyz_to_xyzw(q) -> tuple[float, float, float, float]:
+    """SAPIEN order (w, x, y, z) -> Foxglove order (x, y, z, w), as plain floats."""
+    w, x, y, z = (float(v) for v in q)
+    return x, y, z, w
 
 
 def axis_angle_matrix(axis: np.ndarray, angle_rad: float) -> np.ndarray:

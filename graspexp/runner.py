@@ -7,16 +7,19 @@ Run directory layout (Hydra's output dir)::
     summary.md                     the per-object success table printed at the end
 
 Re-running into the same directory resumes: trials whose log is complete are read back, not re-run.
+With ``record=false`` no log is written (faster, but nothing to replay and nothing to resume from).
 """
 
 import logging
 import platform
 import traceback
+from contextlib import nullcontext
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 import pandas as pd
 from omegaconf import DictConfig, OmegaConf
+from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
 from graspexp.config import validate
@@ -25,7 +28,7 @@ from graspexp.record import CorruptLogError, TrialRecorder, read_result
 from graspexp.seeding import derive_seed
 from graspexp.sim.collision import convex_hulls
 from graspexp.sim.outcome import FailureReason, TrialResult
-from graspexp.sim.trial import TrialContext, plain_config, run_trial, scene_entities, trial_seed
+from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial, scene_entities, trial_seed
 
 log = logging.getLogger(__name__)
 PACKAGES = ("graspexp", "sapien", "numpy", "scikit-learn", "trimesh", "coacd", "mcap", "hydra-core")
@@ -111,7 +114,12 @@ def run_object_trials(
         result = _finished(path)
         if result is None:
             path.parent.mkdir(parents=True, exist_ok=True)
-            with TrialRecorder(path, _metadata(job_meta, object_name, i, seed)) as rec:
+            recorder = (
+                TrialRecorder(path, _metadata(job_meta, object_name, i, seed))
+                if cfg.record
+                else nullcontext(NullRecorder())
+            )
+            with recorder as rec:
                 try:
                     if load_error is not None:
                         raise load_error
@@ -165,6 +173,11 @@ def run_job(cfg: DictConfig) -> float:
 
     validate(cfg)
     run_dir = Path(HydraConfig.get().runtime.output_dir)
+    with threadpool_limits(limits=1):  # trials are sequential and small: one core per job process
+        return _run(cfg, run_dir)
+
+
+def _run(cfg: DictConfig, run_dir: Path) -> float:
     objects = select_objects(cfg)
     results: list[TrialResult] = []
     with tqdm(

@@ -7,7 +7,8 @@ import trimesh
 from omegaconf import OmegaConf
 
 from graspexp.cli import compose_config
-from graspexp.planning import NoFeasibleGrasp, PlanRequest, get_planner, plan
+from graspexp.config import GripperConfig
+from graspexp.planning import Grasp, NoFeasibleGrasp, PlanRequest, get_planner, plan
 from graspexp.planning.collision import cloud_hits, frame_from_axes, gripper_boxes, lowest_z
 
 MINE = ("antipodal", "obb", "random", "optimal_plus")
@@ -55,7 +56,7 @@ def _check_contract(req: PlanRequest, name: str) -> None:
     assert pre[2] >= req.table_z
     # fingertip corners, computed here from the gripper dimensions rather than collision.py
     X, Y, Z = R.T
-    tip = g.position + 0.25 * gr.finger_length_m * Z
+    tip = g.position + gr.tcp_from_tip_m * Z  # the fingertips reach this far past the grasp point
     for sy in (1, -1):
         for side in (g.width_m / 2, g.width_m / 2 + gr.finger_thickness_m):
             for sx in (1, -1):
@@ -114,7 +115,8 @@ def test_random_depends_on_the_seed() -> None:
 
 @pytest.mark.parametrize("name", ["antipodal", "obb", "optimal_plus"])
 def test_object_wider_than_the_stroke_is_infeasible(name: str) -> None:
-    pts, normals = _cloud(trimesh.creation.box((0.3, 0.3, 0.3)))
+    # a sphere, not a box: a box's corner can be pinched between fingers whose tips reach past the point
+    pts, normals = _cloud(trimesh.creation.icosphere(subdivisions=3, radius=0.15))
     with pytest.raises(NoFeasibleGrasp, match=name.split("_")[0]):
         plan(_request(name, pts, normals))
 
@@ -148,37 +150,59 @@ def test_obb_closes_across_the_narrow_side_from_above() -> None:
     assert g.width_m == pytest.approx(0.05 + 2 * 0.005, abs=2e-3)
 
 
-def test_optimal_plus_avoids_the_palm_collision_that_optimal_accepts() -> None:
-    # The upright primitive can (66 x 100 mm), bin mode: the paper's planner grasps a cluster centre about
-    # half-way up from nearly straight above, so the palm (0.75 L behind the grasp point) is inside the
-    # can; optimal_plus must return a grasp whose swept fingers and palm touch no cloud point.
-    from graspexp.datasets import load_object
+# Explicit dimensions (the OnRobot RG2 of the paper), so these tests do not move with conf/gripper.
+RG2 = GripperConfig(
+    name="rg2_test",
+    max_width_m=0.11,
+    grip_force_n=40.0,
+    finger_length_m=0.055,
+    finger_width_m=0.022,
+    finger_thickness_m=0.01,
+    palm_size_m=[0.045, 0.15, 0.06],
+)
 
-    cfg = _cfg("optimal", "bin", "dataset=primitives")
-    model = load_object(cfg.dataset, "can", 2048, 0)
-    pts = model.points + np.array([0.0, 0.0, TABLE_Z - model.points[:, 2].min()])
+
+def _plan_with(name: str, pts, normals, area) -> Grasp:
+    c = _cfg(name, "bin")
+    return plan(PlanRequest(pts, normals, area, np.eye(4), TABLE_Z, "bin", RG2, c.planner, c.cost, 1)).grasp
+
+
+def test_optimal_plus_avoids_the_palm_collision_that_optimal_accepts() -> None:
+    # A can (r 33 mm, 100 mm tall) whose grasping area is its lower 60 mm: the paper's planner grasps the
+    # area's centre nearly straight from above, with the palm inside the can.
+    pts, normals = _cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
+    area = pts[:, 2] < TABLE_Z + 0.06
     hits = {}
     for name in ("optimal", "optimal_plus"):
-        c = _cfg(name, "bin", "dataset=primitives")
-        req = PlanRequest(
-            pts, model.normals, model.area_mask, np.eye(4), TABLE_Z, "bin", c.gripper, c.planner, c.cost, 1
-        )
-        g = plan(req).grasp
-        hits[name] = cloud_hits(pts, g.pose[None], cfg.gripper, g.width_m, sweep_m=0.1, margin_m=0.0)[0]
+        g = _plan_with(name, pts, normals, area)
+        hits[name] = cloud_hits(pts, g.pose[None], RG2, g.width_m, sweep_m=0.1, margin_m=0.0)[0]
     assert hits["optimal"] > 0
     assert hits["optimal_plus"] == 0
+
+
+def test_optimal_plus_keeps_the_fingers_out_of_the_table_where_optimal_does_not() -> None:
+    # The same can, whole surface as area: the paper's planner closes from the side so low that the
+    # lower finger corner dips below the table top (only its sphere point is tested).
+    pts, normals = _cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
+    area = np.ones(len(pts), bool)
+    low = {}
+    for name in ("optimal", "optimal_plus"):
+        g = _plan_with(name, pts, normals, area)
+        low[name] = lowest_z(g.pose[None], RG2, g.width_m, 0.1)[0]
+    assert low["optimal"] < TABLE_Z
+    assert low["optimal_plus"] >= TABLE_Z
 
 
 def test_cloud_hits_counts_points_in_fingers_and_palm_only() -> None:
     gr = _cfg("obb").gripper
     pose = frame_from_axes([0, 0, -1], [0, 1, 0], [0, 0, 0.2])
-    L, w = gr.finger_length_m, 0.06
+    root, w = gr.tcp_from_tip_m - gr.finger_length_m, 0.06  # palm face z in the grasp frame
     local = np.array(
         [
             [0.0, 0.0, 0.0],  # between the pads
             [0.0, w / 2 + gr.finger_thickness_m / 2, 0.0],  # inside the left finger
-            [0.0, 0.0, -0.75 * L - 0.01],  # inside the palm
-            [0.0, 0.0, -0.75 * L - gr.palm_size_m[2] - 0.05],  # swept by the palm on the approach
+            [0.0, 0.0, root - 0.01],  # inside the palm
+            [0.0, 0.0, root - gr.palm_size_m[2] - 0.05],  # swept by the palm on the approach
             [0.0, 0.2, 0.0],  # far out along +Y
         ]
     )
@@ -191,7 +215,7 @@ def test_cloud_hits_counts_points_in_fingers_and_palm_only() -> None:
 def test_lowest_z_of_a_top_down_grasp_is_the_fingertip() -> None:
     gr = _cfg("obb").gripper
     pose = frame_from_axes([0, 0, -1], [0, 1, 0], [0, 0, 0.2])
-    assert lowest_z(pose[None], gr, 0.05, 0.1)[0] == pytest.approx(0.2 - 0.25 * gr.finger_length_m)
+    assert lowest_z(pose[None], gr, 0.05, 0.1)[0] == pytest.approx(0.2 - gr.tcp_from_tip_m)
     boxes = gripper_boxes(gr, 0.05)
     assert boxes[0, 0, 1] == pytest.approx(0.025) and boxes[1, 1, 1] == pytest.approx(-0.025)
 

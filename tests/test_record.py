@@ -348,11 +348,12 @@ def test_scene_entities_follow_foxglove_layout(trial_file):
         and mesh["timestamp"] == {"sec": 0, "nsec": 0}
     )
     (tri,) = mesh["triangles"]
-    assert len(tri["points"]) == 3 * 500 and set(tri["points"][0]) == {"x", "y", "z"}
+    assert len(tri["indices"]) == 3 * 500 and set(tri["points"][0]) == {"x", "y", "z"}
+    assert max(tri["indices"]) == len(tri["points"]) - 1  # vertices stored once, triangles by index
     assert tri["color"] == {"r": 0.8, "g": 0.3, "b": 0.2, "a": 1.0}
     assert tri["pose"]["orientation"] == {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}
-    # compact: six significant digits
-    assert all(len(repr(p["x"]).lstrip("-").replace(".", "").lstrip("0")) <= 6 for p in tri["points"])
+    # compact: rounded to 1 um
+    assert all(round(p["x"], 6) == p["x"] for p in tri["points"])
     (cube,) = table["cubes"]
     assert cube["size"] == {"x": 1.0, "y": 1.0, "z": 0.02}
     assert cube["pose"]["orientation"] == {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}

@@ -7,7 +7,6 @@ Figures are medians over trials (per-phase) and over repeats (throughput).
 """
 
 import argparse
-import os
 import statistics
 import tempfile
 import time
@@ -15,6 +14,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from graspexp.cli import compose_config
 from graspexp.datasets import available_objects, load_object
@@ -29,6 +29,7 @@ PHASES = ("build", "settle", "plan", "execute", "log")
 def _run_object(args: tuple[list[str], str, int, str]) -> list[dict]:
     """All trials of one object with MCAP logging into ``out``; returns per-trial timings."""
     overrides, name, trials, out = args
+    threadpool_limits(limits=1)
     cfg = compose_config(overrides)
     plain = plain_config(cfg)
     model = load_object(cfg.dataset, name, cfg.planner.n_points, derive_seed(cfg.seed, "cloud", name))
@@ -63,7 +64,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--objects", default="", help="comma-separated subset")
     ap.add_argument("--repeats", type=int, default=3, help="repeats of the throughput runs")
     args = ap.parse_args(argv)
-    os.environ.setdefault("OMP_NUM_THREADS", "1")
+    threadpool_limits(limits=1)
     cfg = compose_config(args.overrides)
     names = args.objects.split(",") if args.objects else available_objects(cfg.dataset)
     print(

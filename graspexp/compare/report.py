@@ -19,7 +19,6 @@ planner of one setting must show the same ``(trial, seed)`` pairs for each objec
 listed as warnings (on stderr from the CLI, and in the Markdown).
 """
 
-import math
 import sys
 from pathlib import Path
 

@@ -3,12 +3,13 @@
 Shared by the ``antipodal``, ``obb``, ``random`` and ``optimal_plus`` planners. Pure numpy.
 
 Geometry (the same as :mod:`graspexp.sim.gripper`), in the grasp frame (+Z approach, +Y closing axis,
-origin midway between the pads), for an opening ``w``, finger length ``L``, width ``fw`` (X), thickness
-``t`` (Y) and palm size ``(px, py, pz)``:
+origin midway between the pads), for an opening ``w``, finger span ``[z0, z1]`` along Z
+(:func:`graspexp.config.gripper.finger_z_range_m`: palm face to fingertips), width ``fw`` (X),
+thickness ``t`` (Y) and palm size ``(px, py, pz)``:
 
-- left finger  ``x in [-fw/2, fw/2]``, ``y in [ w/2,  w/2 + t]``, ``z in [-0.75 L, 0.25 L]``;
-- right finger ``x in [-fw/2, fw/2]``, ``y in [-w/2 - t, -w/2]``, ``z in [-0.75 L, 0.25 L]``;
-- palm         ``x in [-px/2, px/2]``, ``y in [-py/2, py/2]``, ``z in [-0.75 L - pz, -0.75 L]``.
+- left finger  ``x in [-fw/2, fw/2]``, ``y in [ w/2,  w/2 + t]``, ``z in [z0, z1]``;
+- right finger ``x in [-fw/2, fw/2]``, ``y in [-w/2 - t, -w/2]``, ``z in [z0, z1]``;
+- palm         ``x in [-px/2, px/2]``, ``y in [-py/2, py/2]``, ``z in [z0 - pz, z0]``.
 
 The trial moves the gripper in a straight line from the pre-grasp pose (``-sweep_m`` along +Z, where
 ``sweep_m = planner.sphere_radius_m``) to the grasp pose with the fingers already open, so the volume a
@@ -25,9 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from graspexp.config import GripperConfig
-
-FINGER_ROOT_FRACTION = 0.75
-"""The finger roots (palm face) sit this fraction of the finger length behind the grasp point."""
+from graspexp.config.gripper import finger_z_range_m
 
 POSE_BATCH = 128
 """Poses per vectorised block in :func:`cloud_hits` (bounds memory at ~POSE_BATCH x N x 3 floats)."""
@@ -35,10 +34,9 @@ POSE_BATCH = 128
 
 def gripper_boxes(gripper: GripperConfig, width_m: float) -> np.ndarray:
     """(3, 2, 3) float64 ``[lo, hi]`` corners of the left finger, right finger and palm, grasp frame, m."""
-    L, fw, t = gripper.finger_length_m, gripper.finger_width_m, gripper.finger_thickness_m
+    fw, t = gripper.finger_width_m, gripper.finger_thickness_m
     px, py, pz = (float(v) for v in gripper.palm_size_m)
-    root = -FINGER_ROOT_FRACTION * L
-    tip = root + L
+    root, tip = finger_z_range_m(gripper)
     h = width_m / 2
     return np.array(
         [
@@ -50,8 +48,8 @@ def gripper_boxes(gripper: GripperConfig, width_m: float) -> np.ndarray:
 
 
 def fingertip_z_offset_m(gripper: GripperConfig) -> float:
-    """How far the fingertips reach past the grasp point along +Z, m (``0.25 L``)."""
-    return (1.0 - FINGER_ROOT_FRACTION) * gripper.finger_length_m
+    """How far the fingertips reach past the grasp point along +Z, m (``gripper.tcp_from_tip_m``)."""
+    return finger_z_range_m(gripper)[1]
 
 
 def lowest_z(poses: np.ndarray, gripper: GripperConfig, widths_m: np.ndarray, sweep_m: float) -> np.ndarray:
@@ -96,10 +94,10 @@ def closing_section(
     -------
     lo, hi : (B,) float64, metres; both 0 where no point is in reach.
     """
-    L, fw = gripper.finger_length_m, gripper.finger_width_m
-    root = -FINGER_ROOT_FRACTION * L
+    fw = gripper.finger_width_m
+    root, tip = finger_z_range_m(gripper)
     x, y, z = local[..., 0], local[..., 1], local[..., 2]
-    reach = (np.abs(x) <= fw / 2 + margin_m) & (z >= root - margin_m) & (z <= root + L + margin_m)
+    reach = (np.abs(x) <= fw / 2 + margin_m) & (z >= root - margin_m) & (z <= tip + margin_m)
     hi = np.where(reach, y, -np.inf).max(axis=1)
     lo = np.where(reach, y, np.inf).min(axis=1)
     some = reach.any(axis=1)
@@ -126,9 +124,9 @@ def cloud_hits(
     poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)
     widths = np.broadcast_to(np.asarray(widths_m, dtype=np.float64), (len(poses),))
     out = np.zeros(len(poses), dtype=np.int64)
-    L, fw, t = gripper.finger_length_m, gripper.finger_width_m, gripper.finger_thickness_m
+    fw, t = gripper.finger_width_m, gripper.finger_thickness_m
     px, py, pz = (float(v) for v in gripper.palm_size_m)
-    root = -FINGER_ROOT_FRACTION * L
+    root, tip = finger_z_range_m(gripper)
     m = margin_m
     for s in range(0, len(poses), POSE_BATCH):
         local = local_coords(points_m, poses[s : s + POSE_BATCH])
@@ -138,7 +136,7 @@ def cloud_hits(
         fingers = (
             (np.abs(x) <= fw / 2 + m)
             & (z >= root - sweep_m - m)
-            & (z <= root + L + m)
+            & (z <= tip + m)
             & (ay >= h - m)
             & (ay <= h + t + m)
         )
@@ -302,7 +300,7 @@ def place_grasps(
 
 MAX_LIFT_FRACTION = 0.8
 """A grasp may move back from its grasp point by at most this fraction of the fingertip reach
-(``0.25 L``), so the point it aimed at stays between the pads."""
+(:func:`fingertip_z_offset_m`), so the point it aimed at stays between the pads."""
 
 
 def max_lift_m(gripper: GripperConfig) -> float:

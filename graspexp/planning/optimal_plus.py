@@ -8,12 +8,12 @@ Eq. (1)-(3) as ``optimal`` (its building blocks are reused unchanged). Then:
    mass of a uniform shell, the best estimate a surface cloud gives) and ``D`` the diagonal of the
    cloud's axis-aligned box, m/m. A grasp near the centre of mass resists the gravity torque that
    makes off-centre grasps rotate and slip once the support goes (collab) or during the lift (bin).
-2. **Opening from the geometry, not only from r_k.** The opening is
-   ``max(2 r_k (1 + width_margin), 2 max|y| + 2 planner.width_clearance_m)`` where ``max|y|`` is the
-   largest distance from the closing plane of any cloud point in the fingers' reach (x within the
-   finger width, z within the finger span); ``2 r_k`` under-estimates the section of round or
-   elongated clusters, so the paper's opening can land a finger on the object. Above the stroke, the
-   path is rejected.
+2. **Opening from the geometry, not only from r_k.** The grasp point slides along the closing axis
+   to the middle of the object's section between the pads (the cloud points within the finger width
+   and span), and the opening is ``max(2 r_k (1 + width_margin), section + 2 width_clearance_m)``:
+   ``2 r_k`` under-estimates the section of round or elongated clusters, and the pads close
+   symmetrically about the grasp point, so the paper's opening about an off-centre cluster centre can
+   land a finger on the object. Above the stroke, the path is rejected.
 3. **Swept-volume collision check.** Each path is checked, in ascending cost, with the finger and palm
    boxes swept along the straight approach against the cloud and against the support plane
    (:func:`graspexp.planning.collision.place_grasps`; a grasp whose boxes would dip below the plane is

@@ -27,8 +27,8 @@ from graspexp.record import schemas as S
 CHUNK_SIZE_BYTES = 1024 * 1024
 """Uncompressed chunk size; a typical trial fits in one or two chunks."""
 
-SCENE_SIGNIFICANT_DIGITS = 6
-"""Floats in /scene messages are rounded to this many significant digits to keep meshes small."""
+SCENE_DECIMALS = 6
+"""Mesh vertices in /scene messages are rounded to this many decimals of a metre (1 um)."""
 
 CONTACT_DECIMALS = {"position": 6, "normal": 6, "force_n": 4, "separation_m": 7}
 """Decimals kept per /contacts quantity (m, unit, N, m): the bulk of a log.
@@ -107,8 +107,9 @@ def mesh_entity(
     """A foxglove.SceneEntity with one TriangleListPrimitive (identity pose in ``frame_id``).
 
     vertices : (V, 3) float, ``frame_id`` frame, m. faces : (F, 3) int indices into vertices.
-    color : (r, g, b, a) in [0, 1], one colour for the whole mesh. Points are flattened per triangle
-    (3F points, no index array); frame_locked is true so the mesh follows ``frame_id``.
+    color : (r, g, b, a) in [0, 1], one colour for the whole mesh. The vertices are stored once
+    (rounded to SCENE_DECIMALS decimals, i.e. 1 um) with an index array of 3F entries; frame_locked is
+    true so the mesh follows ``frame_id``. The entity is plain JSON data, ready for :meth:`TrialWriter.scene`.
     """
     v = np.asarray(vertices, dtype=float)
     f = np.asarray(faces)
@@ -118,7 +119,7 @@ def mesh_entity(
         raise ValueError(f"faces must be (F, 3) integers, got shape {f.shape} dtype {f.dtype}")
     if f.size and (f.min() < 0 or f.max() >= len(v)):
         raise ValueError(f"faces index outside 0..{len(v) - 1}")
-    tri = v[f.reshape(-1)]
+    pts = np.round(v, SCENE_DECIMALS).tolist()
     return {
         "frame_id": frame_id,
         "id": id,
@@ -129,10 +130,10 @@ def mesh_entity(
         "triangles": [
             {
                 "pose": _IDENTITY_POSE,
-                "points": [{"x": p[0], "y": p[1], "z": p[2]} for p in tri.tolist()],
+                "points": [{"x": p[0], "y": p[1], "z": p[2]} for p in pts],
                 "color": _rgba(color),
                 "colors": [],
-                "indices": [],
+                "indices": f.reshape(-1).astype(int).tolist(),
             }
         ],
     }
@@ -236,10 +237,11 @@ class TrialWriter:
     def scene(self, t_s: float, entities: list[dict]) -> None:
         """/scene, foxglove.SceneUpdate: entities from :func:`mesh_entity` / :func:`box_entity`.
 
-        Each entity gets ``timestamp`` = t_s; floats are rounded to SCENE_SIGNIFICANT_DIGITS digits.
+        Each entity gets ``timestamp`` = t_s. The entities are plain JSON data already (the constructors
+        round and convert once), so a scene sent with every trial costs no per-float work here.
         """
         ts = stamp(t_s)
-        ents = [{"timestamp": ts, **to_json_value(e, SCENE_SIGNIFICANT_DIGITS)} for e in entities]
+        ents = [{"timestamp": ts, **e} for e in entities]
         self._write(S.TOPIC_SCENE, t_s, {"deletions": [], "entities": ents})
 
     def transforms(self, t_s: float, frames: Mapping[str, tuple[Sequence[float], Sequence[float]]]) -> None:
@@ -251,21 +253,15 @@ class TrialWriter:
         """
         ts = stamp(t_s)
         for child, (pos, quat_wxyz) in frames.items():
-            p = np.asarray(pos, dtype=float).reshape(-1)
-            q = np.asarray(quat_wxyz, dtype=float).reshape(-1)
-            if p.shape != (3,) or q.shape != (4,):
-                raise ValueError(
-                    f"frame {child!r}: need position (3,) and quaternion (w, x, y, z), got {pos!r}, {quat_wxyz!r}"
-                )
-            if not (np.all(np.isfinite(p)) and np.all(np.isfinite(q))):
-                raise ValueError(f"frame {child!r}: non-finite pose {pos!r}, {quat_wxyz!r}")
-            x, y, z, w = wxyz_to_xyzw(q).tolist()
-            px, py, pz = p.tolist()
+            p = [float(v) for v in pos]
+            x, y, z, w = wxyz_to_xyzw(quat_wxyz)
+            if len(p) != 3 or not all(map(math.isfinite, (*p, x, y, z, w))):
+                raise ValueError(f"frame {child!r}: need a finite position (3,) and quaternion (w, x, y, z)")
             msg = {
                 "timestamp": ts,
                 "parent_frame_id": "world",
                 "child_frame_id": child,
-                "translation": {"x": px, "y": py, "z": pz},
+                "translation": {"x": p[0], "y": p[1], "z": p[2]},
                 "rotation": {"x": x, "y": y, "z": z, "w": w},
             }
             self._write(S.TOPIC_TF, t_s, msg)
@@ -308,7 +304,7 @@ class TrialWriter:
                         "separation_m": sp,
                     }
                 )
-        msg = {"timestamp": stamp(t_s), "contacts": to_json_value(out)}
+        msg = {"timestamp": stamp(t_s), "contacts": out}  # plain rounded floats already
         self._write(S.TOPIC_CONTACTS, t_s, msg)
 
     def grasp(self, t_s: float, grasp: Mapping[str, Any]) -> None:

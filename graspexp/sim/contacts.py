@@ -44,22 +44,28 @@ def gripper_touches_support(contacts: list) -> bool:
 
 
 def contact_records(contacts: list, dt: float) -> list[dict]:
-    """Every touching contact point as a plain dict for the log (world frame, N, m)."""
+    """One record per touching body pair for the log (world frame, N, m): the pair's total contact force
+    on ``body0``, the force-weighted mean position and normal of its points, and the smallest separation.
+    Pairs whose points all carry (near) zero impulse are proximity reports and are left out."""
     out = []
     for c in contacts:
+        pts = c.points
+        imp = np.array([p.impulse for p in pts], dtype=float)
+        w = np.sqrt((imp * imp).sum(axis=1))
+        total = float(w.sum())
+        if total <= MIN_IMPULSE_NS:
+            continue
         a, b = _pair_names(c)
-        for p in c.points:
-            impulse = np.asarray(p.impulse, dtype=float)
-            if np.linalg.norm(impulse) <= MIN_IMPULSE_NS:
-                continue
-            out.append(
-                {
-                    "body0": a,
-                    "body1": b,
-                    "position": [float(v) for v in p.position],
-                    "normal": [float(v) for v in p.normal],
-                    "force_n": [float(v) for v in impulse / dt],
-                    "separation_m": float(p.separation),
-                }
-            )
+        pos = np.array([p.position for p in pts], dtype=float)
+        nrm = (w @ np.array([p.normal for p in pts], dtype=float)) / total
+        out.append(
+            {
+                "body0": a,
+                "body1": b,
+                "position": ((w @ pos) / total).tolist(),
+                "normal": (nrm / (np.linalg.norm(nrm) or 1.0)).tolist(),
+                "force_n": (imp.sum(axis=0) / dt).tolist(),
+                "separation_m": float(min(p.separation for p in pts)),
+            }
+        )
     return out
