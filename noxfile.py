@@ -61,3 +61,23 @@ def reproduce(session: nox.Session) -> None:
     session.log(
         f"reproduce: sweep {sweep_s:.1f} s, report {total_s - sweep_s:.1f} s, wall time {total_s:.1f} s"
     )
+
+
+@nox.session(venv_backend="none")
+def compare(session: nox.Session) -> None:
+    """Five planners x pose noise on a small setting (primitives can/mug/banana, bin, rot z, 3 trials),
+    then ``python -m graspexp.compare``. ``nox -s compare -- DIR [overrides...]`` (default outputs/compare);
+    resumable."""
+    out = session.posargs[0] if session.posargs else "outputs/compare"
+    extra = list(session.posargs[1:])
+    start = time.perf_counter()
+    session.run(
+        "python", "-m", "graspexp", "-m",
+        "planner=optimal,optimal_plus,antipodal,obb,random",
+        "perception.noise.trans_mm=0,10,20", "perception.noise.rot_deg=0,10",
+        "dataset=primitives", "objects=[can,mug,banana]", "mode=bin", "rot=z", "trials=3",
+        "progress=false", "hydra/launcher=joblib", f"hydra.sweep.dir={out}", *extra,
+        env=ENV, external=True,
+    )  # fmt: skip
+    session.run("python", "-m", "graspexp.compare", out, "--out", f"{out}/compare", env=ENV, external=True)
+    session.log(f"compare: {time.perf_counter() - start:.0f} s wall")

@@ -101,3 +101,22 @@ def test_cli_prints_markdown_and_fails_on_an_empty_dir(tmp_path, capsys) -> None
     (tmp_path / "empty").mkdir()
     assert main([str(tmp_path / "empty")]) == 2
     assert not math.isnan(wilson_interval(1, 2)[0])
+
+
+def test_quality_table_splits_success_by_force_closure():
+    import pandas as pd
+
+    from graspexp.compare.report import quality_table
+
+    base = {"dataset": "primitives", "mode": "bin", "rot": "z", "trans_mm": 0.0, "rot_deg": 0.0, "planner": "p"}
+    rows = [
+        {**base, "reason": None, "success": True, "fc_min_mu": 0.2},
+        {**base, "reason": "slipped", "success": False, "fc_min_mu": 0.4},
+        {**base, "reason": "dropped", "success": False, "fc_min_mu": float("nan")},
+        {**base, "reason": "no_feasible_grasp", "success": False, "fc_min_mu": float("nan")},
+    ]
+    (q,) = quality_table(pd.DataFrame(rows)).to_dict("records")
+    assert q["planned"] == 3
+    assert q["fc_pct"] == pytest.approx(200 / 3)
+    assert q["median_mu"] == pytest.approx(0.3)
+    assert q["success_if_fc_pct"] == 50.0 and q["success_if_not_fc_pct"] == 0.0

@@ -176,7 +176,7 @@ def test_round_trip_file(trial_file):
         "/contacts": "graspexp.Contacts@1",
         "/grasp": "graspexp.PlannedGrasp@1",
         "/phase": "graspexp.Phase@1",
-        "/result": "graspexp.TrialResult@1",
+        "/result": "graspexp.TrialResult@2",
     }
     n = int(RATE_HZ * DURATION_S)
     assert sorted(log.transforms) == ["finger_left", "finger_right", "gripper", "object"]
@@ -361,7 +361,7 @@ def test_scene_entities_follow_foxglove_layout(trial_file):
 
 def test_result_schema_pinned():
     """Changing TrialResult's fields must come with a new graspexp.TrialResult@N version."""
-    assert S.TRIAL_RESULT == "graspexp.TrialResult@1"
+    assert S.TRIAL_RESULT == "graspexp.TrialResult@2"
     assert list(S.SCHEMAS[S.TRIAL_RESULT]["properties"]) == [
         "dataset",
         "object",
@@ -377,6 +377,7 @@ def test_result_schema_pinned():
         "grasp_cost",
         "grasp_width_m",
         "n_feasible",
+        "fc_min_mu",
         "slip_m",
         "finger_force_n",
         "touched_support",

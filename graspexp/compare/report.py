@@ -70,9 +70,10 @@ def collect_trials(root: Path | str) -> tuple[pd.DataFrame, list[str]]:
         row = {
             k: res.get(k) for k in ("dataset", "mode", "rot", "planner", "object", "trial", "seed", "reason")
         }
+        row["fc_min_mu"] = float(res.get("fc_min_mu", float("nan")))
         row.update(success=bool(res.get("success")), trans_mm=trans_mm, rot_deg=rot_deg, path=str(path))
         rows.append(row)
-    cols = [*TRIAL_KEYS, "seed", "success", "reason", "path"]
+    cols = [*TRIAL_KEYS, "seed", "success", "reason", "fc_min_mu", "path"]
     df = pd.DataFrame(rows, columns=cols)
     dup = df.duplicated(list(TRIAL_KEYS), keep="first")
     for p in df.loc[dup, "path"]:
@@ -98,6 +99,34 @@ def success_table(df: pd.DataFrame) -> pd.DataFrame:
         )
     cols = [*GROUP_KEYS, "planner", "n", "successes", "success_pct", "ci_lo_pct", "ci_hi_pct"]
     return pd.DataFrame(out, columns=cols)
+
+
+FC_MU = 0.8
+"""Friction at which "force-closure" is judged in the quality table: PhysX averages the object's 0.6 and
+the pads' 1.0 static friction to 0.8 in these simulations."""
+
+
+def quality_table(df: pd.DataFrame) -> pd.DataFrame:
+    """Physics-free grasp quality beside the simulated outcome, per setting and planner: share of planned
+    grasps that are force-closure at mu <= FC_MU, median smallest mu, and the simulated success rate of
+    the force-closure grasps and of the others (%; NaN where a group is empty)."""
+    out = []
+    planned = df[df["reason"] != "no_feasible_grasp"]
+    for key, g in planned.groupby([*GROUP_KEYS, "planner"], sort=True):
+        fc = g["fc_min_mu"] <= FC_MU + 1e-9
+        out.append(
+            {
+                **dict(zip([*GROUP_KEYS, "planner"], key, strict=True)),
+                "planned": len(g),
+                "fc_pct": 100.0 * fc.mean(),
+                "median_mu": float(g["fc_min_mu"].median()),
+                "success_if_fc_pct": 100.0 * g.loc[fc, "success"].mean() if fc.any() else float("nan"),
+                "success_if_not_fc_pct": 100.0 * g.loc[~fc, "success"].mean()
+                if (~fc).any()
+                else float("nan"),
+            }
+        )
+    return pd.DataFrame(out)
 
 
 def check_same_drops(df: pd.DataFrame) -> list[str]:
@@ -149,6 +178,32 @@ def render_markdown(table: pd.DataFrame, drop_warnings: list[str], other_warning
     return "\n".join(lines) + "\n"
 
 
+def render_quality(quality: pd.DataFrame) -> str:
+    """Markdown of :func:`quality_table`."""
+    if quality.empty:
+        return ""
+    lines = [
+        "",
+        f"## Grasp quality without physics (force closure at mu <= {FC_MU:g}) beside the simulated outcome",
+        "",
+        "| dataset | mode | rot | noise trans mm | noise rot deg | planner | planned | force-closure % | "
+        "median min mu | success % if FC | success % if not FC |",
+        "|" + "---|" * 11,
+    ]
+    for r in quality.itertuples():
+        lines.append(
+            f"| {r.dataset} | {r.mode} | {r.rot} | {r.trans_mm:g} | {r.rot_deg:g} | {r.planner} | {r.planned} | "
+            f"{r.fc_pct:.0f} | {r.median_mu:.2f} | {r.success_if_fc_pct:.0f} | {r.success_if_not_fc_pct:.0f} |"
+        )
+    lines += [
+        "",
+        "min mu: smallest of 0.2, 0.4, ..., 1.2 at which the two finger contacts are force-closure "
+        "(NaN: none; excluded from the median).",
+        "",
+    ]
+    return "\n".join(lines)
+
+
 def _panel(ax, df: pd.DataFrame, key: str, other: str, unit: str) -> None:
     sub = df[df[other] == 0] if (df[other] == 0).any() else df
     for planner, g in sub.groupby("planner", sort=True):
@@ -187,9 +242,11 @@ def write_report(root: Path | str, out: Path | str | None = None) -> tuple[str, 
     df, warnings = collect_trials(root)
     table = success_table(df)
     drops = check_same_drops(df)
-    md = render_markdown(table, drops, warnings)
+    quality = quality_table(df)
+    md = render_markdown(table, drops, warnings) + render_quality(quality)
     out.mkdir(parents=True, exist_ok=True)
     table.to_csv(out / "compare.csv", index=False)
+    quality.to_csv(out / "quality.csv", index=False)
     (out / "compare.md").write_text(md)
     plot_success_vs_noise(df, out / "success_vs_noise.png")
     for w in [*drops, *warnings]:

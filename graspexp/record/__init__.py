@@ -2,7 +2,7 @@
 
 Topics and schemas (JSON messages, JSON Schema; log_time = simulation time in ns):
 ``/scene`` foxglove.SceneUpdate, ``/tf`` foxglove.FrameTransform, ``/contacts`` graspexp.Contacts@1,
-``/grasp`` graspexp.PlannedGrasp@1, ``/phase`` graspexp.Phase@1, ``/result`` graspexp.TrialResult@1.
+``/grasp`` graspexp.PlannedGrasp@1, ``/phase`` graspexp.Phase@1, ``/result`` graspexp.TrialResult@2.
 """
 
 from graspexp.record.reader import CorruptLogError, TrialLog, iter_trial_logs, read_result, read_trial

@@ -29,7 +29,7 @@ SCENE_UPDATE = "foxglove.SceneUpdate"
 CONTACTS = "graspexp.Contacts@1"
 PLANNED_GRASP = "graspexp.PlannedGrasp@1"
 PHASE = "graspexp.Phase@1"
-TRIAL_RESULT = "graspexp.TrialResult@1"
+TRIAL_RESULT = "graspexp.TrialResult@2"
 
 TOPIC_SCENE = "/scene"
 TOPIC_TF = "/tf"
@@ -60,6 +60,7 @@ PHASE_NAMES = (
     "lift",
     "hold",
     "done",
+    "quality",
     "failed",
 )
 """The phase names the trial protocol uses (the Phase schema accepts any string)."""

@@ -330,7 +330,7 @@ class TrialWriter:
         self._write(S.TOPIC_PHASE, t_s, to_json_value(msg))
 
     def result(self, t_s: float, result: Mapping[str, Any] | Any) -> None:
-        """/result, graspexp.TrialResult@1: ``TrialResult.to_dict()`` (a TrialResult is accepted too).
+        """/result, graspexp.TrialResult@2: ``TrialResult.to_dict()`` (a TrialResult is accepted too).
 
         NaN floats are written as null and read back as NaN. The result is written in its own chunk so
         :func:`graspexp.record.reader.read_result` decompresses only that.

@@ -27,7 +27,7 @@ class FailureReason(str, enum.Enum):
 
 @dataclass
 class TrialResult:
-    """One row of the results table; also the ``graspexp.TrialResult@1`` MCAP message."""
+    """One row of the results table; also the ``graspexp.TrialResult@2`` MCAP message."""
 
     dataset: str
     object: str
@@ -44,6 +44,9 @@ class TrialResult:
     grasp_cost: float = float("nan")
     grasp_width_m: float = float("nan")
     n_feasible: int = 0
+    fc_min_mu: float = float("nan")
+    """Smallest friction coefficient (of 0.2, 0.4, ..., 1.2) at which the planned grasp's two finger contacts
+    are force-closure on the true object pose, without physics; NaN when none is (or the line misses)."""
     slip_m: float = float("nan")
     finger_force_n: list[float] = field(default_factory=list)
     touched_support: bool = False

@@ -2,6 +2,7 @@
 remove the box and hold (collab) or pull back and lift (bin). Staged checks stop at the first failure.
 """
 
+import dataclasses
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -17,6 +18,7 @@ from graspexp.geometry import axis_angle_matrix, make_pose, random_rotation, tra
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.registry import plan
 from graspexp.planning.request import PlanRequest
+from graspexp.quality import grasp_quality
 from graspexp.seeding import derive_seed, rng_for
 from graspexp.sim.contacts import contact_records, finger_forces, gripper_touches_support
 from graspexp.sim.gripper import FINGER_NAMES, Gripper, build_gripper
@@ -262,6 +264,7 @@ def run_trial(ctx: TrialContext) -> TrialResult:
         with sim.timed("plan"):
             grasp = _plan(ctx, sim)
         res.grasp_cost, res.grasp_width_m, res.n_feasible = grasp.cost, grasp.width_m, grasp.n_feasible
+        res.fc_min_mu = _force_closure_mu(ctx, sim, grasp)
         with sim.timed("execute"):
             _execute(ctx, sim, grasp, res)
         res.success = True
@@ -325,6 +328,17 @@ def _plan(ctx: TrialContext, sim: _Sim) -> Grasp:
     sim.phase("plan")
     ctx.recorder.grasp(sim.t, _grasp_record(grasp))
     return grasp
+
+
+def _force_closure_mu(ctx: TrialContext, sim: _Sim, grasp: Grasp) -> float:
+    """Force-closure friction of the planned grasp on the object's true pose (the grasp is moved into the
+    object frame, so the mesh's ray-cast index is built once per object, not per trial); logged on /grasp."""
+    T = sim.ts.object_pose()
+    in_object = dataclasses.replace(grasp, pose=np.linalg.inv(T) @ grasp.pose)
+    mu = grasp_quality(ctx.model.mesh, in_object)["fc_min_mu"]
+    mu = mu if np.isfinite(mu) else float("nan")
+    ctx.recorder.phase(sim.t, "quality", {"fc_min_mu": mu})
+    return mu
 
 
 def _held(sim: _Sim, grasp: Grasp) -> dict[str, float]:
