@@ -49,6 +49,13 @@ CONSTRAINTS: dict[str, tuple[Callable[[object], bool], str]] = {
     "planner.n_points": (lambda v: v >= 16, "an integer >= 16"),
     "planner.main_axis": (lambda v: v in ("object", "area"), "one of object, area"),
     "planner.auto_k_stroke_fraction": (_positive, "a positive number"),
+    "planner.n_candidates": (lambda v: v >= 1, "a positive integer"),
+    "planner.n_approach": (lambda v: v >= 1, "a positive integer"),
+    "planner.friction_coef": (_non_negative, "a non-negative number"),
+    "planner.approach_tilt_weight": (_non_negative, "a non-negative number"),
+    "planner.collision_margin_m": (_non_negative, "a non-negative number"),
+    "planner.width_clearance_m": (_non_negative, "a non-negative number"),
+    "planner.com_weight": (_non_negative, "a non-negative number"),
     "planner.sphere_radius_m": (_positive, "a positive number"),
     "planner.width_margin": (_non_negative, "a non-negative number"),
     "sim.timestep_s": (lambda v: 0 < v <= 0.02, "a step in (0, 0.02] s"),
@@ -69,6 +76,14 @@ def validate(cfg: DictConfig) -> None:
             continue
         if not ok(value):
             raise ConfigError(f"{key}={value!r} is invalid: expected {expected}")
+    name = OmegaConf.select(cfg, "planner.name", default=None)
+    if name is not None:
+        from graspexp.planning.registry import PLANNERS
+
+        if name not in PLANNERS:
+            raise ConfigError(
+                f"planner.name={name!r} is invalid: expected one of {', '.join(sorted(PLANNERS))}"
+            )
     g = cfg.get("gripper")
     if g is not None and g.min_width_m >= g.max_width_m:
         raise ConfigError(

@@ -1,0 +1,113 @@
+"""Config tier: every option of every group composes and validates; bad overrides are one clear line."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from graspexp.cli import CONF_DIR, split_argv
+from graspexp.config import ConfigError, validate
+from tests.conftest import compose_cfg
+
+REPO = Path(__file__).resolve().parent.parent
+GROUPS = {
+    g.name: sorted(p.stem for p in g.glob("*.yaml"))
+    for g in Path(CONF_DIR).iterdir()
+    if g.is_dir() and g.name != "hydra"
+}
+
+
+@pytest.mark.parametrize(("group", "option"), [(g, o) for g, opts in GROUPS.items() for o in opts])
+def test_every_option_of_every_group_composes_and_validates(group, option):
+    cfg = compose_cfg(f"{group}={option}")
+    validate(cfg)
+    if group not in ("cost", "sim"):  # single-option groups without a name field
+        assert cfg[group].name == option
+
+
+def test_groups_are_the_documented_ones():
+    assert {"dataset", "mode", "rot", "gripper", "planner", "cost", "sim"} <= set(GROUPS)
+    assert GROUPS["gripper"] == ["panda", "rg2", "robotiq_2f85"]
+    assert {"optimal", "optimal_plus", "antipodal", "obb", "random"} <= set(GROUPS["planner"])
+
+
+def test_paper_defaults():
+    cfg = compose_cfg()
+    assert (cfg.dataset.name, cfg.mode.name, cfg.rot.name, cfg.gripper.name) == (
+        "primitives",
+        "collab",
+        "z",
+        "rg2",
+    )
+    assert cfg.planner.m == 256 and cfg.planner.k == "auto" and cfg.trials == 10
+    assert (cfg.gripper.max_width_m, cfg.gripper.grip_force_n) == (0.110, 40.0)
+    c = cfg.cost
+    assert (c.angle_weight, c.angle_target_deg, c.angle_offset, c.angle_divisor) == (0.1, 90.0, 0.5, 8.0)
+    assert (c.distance_numerator_mm2, c.distance_offset_mm2, c.table_offset, c.table_beta_divisor) == (
+        20,
+        1,
+        0.05,
+        2,
+    )
+
+
+@pytest.mark.parametrize(
+    ("override", "message"),
+    [
+        ("trials=0", "trials=0 is invalid: expected a positive integer"),
+        (
+            "gripper.min_width_m=0.2",
+            "gripper.min_width_m=0.2 is invalid: must be below gripper.max_width_m=0.11",
+        ),
+        ("planner.k=0", "planner.k=0 is invalid: expected 'auto' or a positive integer"),
+        (
+            "planner.main_axis=diagonal",
+            "planner.main_axis='diagonal' is invalid: expected one of object, area",
+        ),
+    ],
+)
+def test_out_of_range_values_name_the_key(override, message):
+    with pytest.raises(ConfigError, match="^" + message.replace("(", r"\(").replace(")", r"\)") + "$"):
+        validate(compose_cfg(override))
+
+
+@pytest.mark.parametrize(
+    ("args", "line"),
+    [
+        (
+            ["mode=foo"],
+            "graspexp: error: In 'config': Could not find 'mode/foo'; Available options in 'mode': bin, collab",
+        ),
+        (["mode.nme=3"], "graspexp: error: Could not override 'mode.nme'. Key 'nme' not in 'ModeConfig'"),
+        (
+            ["-m", "rot=z,q"],
+            "graspexp: error: In 'config': Could not find 'rot/q'; Available options in 'rot': xyz, z",
+        ),
+        (["trials=-2"], "graspexp: error: trials=-2 is invalid: expected a positive integer"),
+    ],
+)
+def test_bad_override_is_one_line_and_exit_2(args, line):
+    proc = subprocess.run(
+        [sys.executable, "-m", "graspexp", *args], cwd=REPO, capture_output=True, text=True, timeout=60
+    )
+    assert proc.returncode == 2
+    assert proc.stderr.strip() == line
+    assert "Traceback" not in proc.stderr
+
+
+def test_cfg_job_prints_the_composed_config():
+    args = ["--cfg", "job", "mode=bin", "rot=xyz", "dataset=linemod", "gripper=robotiq_2f85"]
+    proc = subprocess.run(
+        [sys.executable, "-m", "graspexp", *args], cwd=REPO, capture_output=True, text=True, timeout=60
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "name: robotiq_2f85" in proc.stdout and "max_width_m: 0.085" in proc.stdout
+    assert "name: linemod" in proc.stdout and "pull_back_m: 0.1" in proc.stdout
+
+
+def test_split_argv_drops_flags_and_their_values():
+    assert split_argv(["--cfg", "job", "-m", "mode=bin", "--config-name", "x", "rot=z"]) == [
+        "mode=bin",
+        "rot=z",
+    ]
