@@ -32,9 +32,11 @@ m), ``best`` (k, p), ``pose``, ``width``, ``mode``, ``table_z``, ``sphere_radius
 ``gripper_max_width``.
 """
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from graspexp.planning.clusters import choose_k, main_axis, segment
+from graspexp.planning.clusters import Clusters, choose_k, main_axis, segment
 from graspexp.planning.cost import cluster_costs
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.paths import above_support, approach_directions
@@ -53,14 +55,29 @@ def kmeans_random_state(seed: int, planner_seed: int) -> int:
     return derive_seed(seed, "kmeans", planner_seed) % (2**32)
 
 
-def plan_optimal(req: PlanRequest) -> PlanResult:
-    """Plan one grasp with the paper's strategy; see the module doc for the steps and ``details`` keys.
+@dataclass(frozen=True)
+class Candidates:
+    """Steps 1-6 of the paper's strategy for one request: everything before a path is chosen.
 
-    Raises
-    ------
-    NoFeasibleGrasp
-        Empty grasping area; every path crosses the support plane; or every remaining path finds the
-        object wider than the gripper's stroke.
+    points : (N, 3) world m; area_mask : (N,) bool; axis : (3,) unit main axis; clusters : K-means result;
+    directions : (K, M, 3) unit approach directions; feasible : (K, M) above the support;
+    costs : (K, M) Eq. (1) or (2)-(3), inf where infeasible.
+    """
+
+    points: np.ndarray
+    area_mask: np.ndarray
+    axis: np.ndarray
+    clusters: Clusters
+    directions: np.ndarray
+    feasible: np.ndarray
+    costs: np.ndarray
+
+
+def paper_candidates(req: PlanRequest, planner: str) -> Candidates:
+    """Grasping area -> main axis -> K-means -> Fibonacci paths -> support test -> cost, as in section III.
+
+    ``planner`` names the caller in error messages. Raises NoFeasibleGrasp for an empty area or when every
+    path starts below the support plane; ValueError for malformed inputs.
     """
     points = np.asarray(req.points, dtype=np.float64)
     mask = np.asarray(req.area_mask, dtype=bool)
@@ -72,25 +89,22 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
         raise ValueError(f"mode={req.mode!r} is invalid: expected one of collab, bin")
     area = points[mask]
     if len(area) == 0:
-        raise NoFeasibleGrasp("the grasping area is empty: no point of the cloud is in area_mask")
+        raise NoFeasibleGrasp(f"{planner}: the grasping area is empty: no point of the cloud is in area_mask")
 
     pl, gr = req.planner, req.gripper
     axis = main_axis(points if pl.main_axis == "object" else area)
     k = choose_k(pl.k, pl.k_max, area, axis, gr.max_width_m, pl.auto_k_stroke_fraction)
     clusters = segment(area, k, random_state=kmeans_random_state(req.seed, pl.seed))
     centers, radii = clusters.centers_m, clusters.radii_m
-    k = len(centers)
-    m = int(pl.m)
+    k, m = len(centers), int(pl.m)
 
     directions = approach_directions(centers, m)  # (K, M, 3)
     feasible = above_support(centers, directions, pl.sphere_radius_m, req.table_z, pl.table_clearance_m)
     if not feasible.any():
         raise NoFeasibleGrasp(
-            f"every one of the {k * m} paths starts below the support plane z = "
+            f"{planner}: every one of the {k * m} paths starts below the support plane z = "
             f"{req.table_z + pl.table_clearance_m:.4f} m (sphere radius {pl.sphere_radius_m} m)"
         )
-    n_table_ok = int(feasible.sum())
-
     costs = np.full((k, m), np.inf)
     for j in range(k):
         ok = feasible[j]
@@ -106,6 +120,30 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
                 gr.max_width_m,
                 req.cost,
             )
+    return Candidates(points, mask, axis, clusters, directions, feasible, costs)
+
+
+def plan_optimal(req: PlanRequest) -> PlanResult:
+    """Plan one grasp with the paper's strategy; see the module doc for the steps and ``details`` keys.
+
+    Raises
+    ------
+    NoFeasibleGrasp
+        Empty grasping area; every path crosses the support plane; or every remaining path finds the
+        object wider than the gripper's stroke.
+    """
+    cand = paper_candidates(req, NAME)
+    pl, gr = req.planner, req.gripper
+    points, mask, axis, clusters = cand.points, cand.area_mask, cand.axis, cand.clusters
+    centers, radii, directions, feasible, costs = (
+        clusters.centers_m,
+        clusters.radii_m,
+        cand.directions,
+        cand.feasible,
+        cand.costs,
+    )
+    k, m = costs.shape
+    n_table_ok = int(feasible.sum())
 
     openings = np.array([opening_width_m(float(r), pl.width_margin, gr) for r in radii])  # (K,) m
     spans = np.full((k, m, 2), np.nan)  # [y_lo, y_hi] of the section between the pads (nan: not examined)

@@ -30,12 +30,9 @@ plus ``com`` (3,) and ``com_factor`` (K,).
 
 import numpy as np
 
-from graspexp.planning.clusters import choose_k, main_axis, segment
 from graspexp.planning.collision import max_lift_m, place_grasps
-from graspexp.planning.cost import cluster_costs
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
-from graspexp.planning.optimal import kmeans_random_state
-from graspexp.planning.paths import above_support, approach_directions
+from graspexp.planning.optimal import paper_candidates
 from graspexp.planning.pose import grasp_rotations, opening_width_m
 from graspexp.planning.request import PlanRequest, PlanResult
 
@@ -67,44 +64,12 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
     pl, gr = req.planner, req.gripper
     if pl.com_weight < 0:
         raise ValueError(f"planner.com_weight={pl.com_weight!r} is invalid: expected a non-negative number")
-    points = np.asarray(req.points, dtype=np.float64)
-    mask = np.asarray(req.area_mask, dtype=bool)
-    if req.mode not in ("collab", "bin"):
-        raise ValueError(f"mode={req.mode!r} is invalid: expected one of collab, bin")
-    area = points[mask]
-    if len(area) == 0:
-        raise NoFeasibleGrasp(
-            "optimal_plus: the grasping area is empty: no point of the cloud is in area_mask"
-        )
-
-    axis = main_axis(area)
-    k = choose_k(pl.k, pl.k_max, area, axis, gr.max_width_m)
-    clusters = segment(area, k, random_state=kmeans_random_state(req.seed, pl.seed))
-    centers, radii = clusters.centers_m, clusters.radii_m
-    k, m = len(centers), int(pl.m)
-    directions = approach_directions(centers, m)
-    feasible = above_support(centers, directions, pl.sphere_radius_m, req.table_z, pl.table_clearance_m)
-    if not feasible.any():
-        raise NoFeasibleGrasp(
-            f"optimal_plus: every one of the {k * m} paths starts below the support plane z = "
-            f"{req.table_z + pl.table_clearance_m:.4f} m (sphere radius {pl.sphere_radius_m} m)"
-        )
+    cand = paper_candidates(req, NAME)
+    points, axis, directions, feasible = cand.points, cand.axis, cand.directions, cand.feasible
+    centers, radii = cand.clusters.centers_m, cand.clusters.radii_m
+    k, m = cand.costs.shape
     factors, com = com_factors(centers, points, pl.com_weight)
-    costs = np.full((k, m), np.inf)
-    for j in range(k):
-        ok = feasible[j]
-        if ok.any():
-            costs[j, ok] = factors[j] * cluster_costs(
-                points,
-                centers[j],
-                radii[j],
-                directions[j, ok],
-                axis,
-                req.mode,
-                req.table_z,
-                gr.max_width_m,
-                req.cost,
-            )
+    costs = factors[:, None] * cand.costs
     openings = np.array([opening_width_m(float(r), pl.width_margin, gr) for r in radii])
 
     order = np.argsort(costs, axis=None, kind="stable")[: int(feasible.sum())]
@@ -167,8 +132,8 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
     )
     details = {
         "cloud": points,
-        "area_mask": mask,
-        "labels": clusters.labels,
+        "area_mask": cand.area_mask,
+        "labels": cand.clusters.labels,
         "centers": centers,
         "radii": radii,
         "main_axis": axis,
