@@ -108,7 +108,14 @@ def test_quality_table_splits_success_by_force_closure():
 
     from graspexp.compare.report import quality_table
 
-    base = {"dataset": "primitives", "mode": "bin", "rot": "z", "trans_mm": 0.0, "rot_deg": 0.0, "planner": "p"}
+    base = {
+        "dataset": "primitives",
+        "mode": "bin",
+        "rot": "z",
+        "trans_mm": 0.0,
+        "rot_deg": 0.0,
+        "planner": "p",
+    }
     rows = [
         {**base, "reason": None, "success": True, "fc_min_mu": 0.2},
         {**base, "reason": "slipped", "success": False, "fc_min_mu": 0.4},

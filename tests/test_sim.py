@@ -22,6 +22,8 @@ pytestmark = pytest.mark.sim
 class ContactCapture(NullRecorder):
     """Keeps every logged contact and phase in memory."""
 
+    active = True
+
     def __init__(self):
         self.points, self.phases = [], []
 

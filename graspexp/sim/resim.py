@@ -16,6 +16,8 @@ POSE_TOLERANCE = 1e-6
 class _PoseCapture(NullRecorder):
     """Keeps the transforms a trial would log, in memory."""
 
+    active = True
+
     def __init__(self):
         self.samples: dict[str, list[tuple[float, np.ndarray]]] = {}
 

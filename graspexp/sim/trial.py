@@ -40,7 +40,10 @@ class TrialFailed(Exception):
 
 
 class NullRecorder:
-    """Stands in for a :class:`graspexp.record.TrialRecorder` when logging is off."""
+    """Stands in for a :class:`graspexp.record.TrialRecorder` when logging is off: every method is a no-op.
+    Subclasses that keep some messages set ``active = True``, so the trial gathers them."""
+
+    active = False
 
     def __getattr__(self, name):
         return lambda *args, **kwargs: None
@@ -110,6 +113,7 @@ class _Sim:
         self.watch_support = False
         self.touched_support = False
         self.max_speed_sq = float(cfg.sim.max_speed_mps) ** 2
+        self.recording = getattr(recorder, "active", True)
 
     def run(self, seconds: float, each_step=None) -> None:
         n = max(1, int(round(seconds / self.dt)))
@@ -131,7 +135,7 @@ class _Sim:
             raise TrialFailed(
                 FailureReason.COLLISION_SUPPORT, f"gripper touched the support at t={self.t:.3f} s"
             )
-        if self.steps % self.log_every == 0:
+        if self.recording and self.steps % self.log_every == 0:
             self.log()
 
     def _check_stable(self) -> None:
