@@ -14,7 +14,7 @@ Steps (cloud and normals in the world frame, metres; normals point outwards):
    -Z onto the plane normal to ``v``);
 4. every candidate is opened, moved back if a box would dip below the support, and checked for finger
    and palm collisions with the cloud and the support along the straight approach
-   (:func:`graspexp.planning.collision.place_grasps`);
+   (:func:`graspexp.planning.collision.place_for_request`);
 5. cost = ``max(a1, a2)`` (degrees) + ``planner.approach_tilt_weight`` * the angle between the approach
    and world -Z (degrees); the cheapest surviving candidate wins. Pairs are examined in ascending
    ``max(a1, a2)``, which is a lower bound on their cost, so examination stops once it exceeds the best.
@@ -26,7 +26,7 @@ examined), ``best_pair`` (2,).
 
 import numpy as np
 
-from graspexp.planning.collision import frame_from_axes, max_lift_m, place_grasps
+from graspexp.planning.collision import frame_from_axes, place_for_request
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.request import PlanRequest, PlanResult
 
@@ -145,16 +145,7 @@ def plan_antipodal(req: PlanRequest) -> PlanResult:
             costs.append(angles[i] + pl.approach_tilt_weight * tilt_deg(dirs))
             owners += [i] * len(dirs)
         examined = batch.stop
-        placed = place_grasps(
-            points,
-            np.array(poses),
-            gr,
-            sweep_m=pl.sphere_radius_m,
-            table_z=req.table_z,
-            margin_m=pl.collision_margin_m,
-            clearance_m=pl.width_clearance_m,
-            max_lift_m=max_lift_m(gr),
-        )
+        placed = place_for_request(req, np.array(poses))
         for key, n in placed.counts().items():
             rejected[key] += n
         n_ok += int(placed.ok.sum())

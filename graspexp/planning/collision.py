@@ -306,3 +306,20 @@ MAX_LIFT_FRACTION = 0.8
 def max_lift_m(gripper: GripperConfig) -> float:
     """Largest back-off along -Z that :func:`place_grasps` may apply to clear the support, m."""
     return MAX_LIFT_FRACTION * fingertip_z_offset_m(gripper)
+
+
+def place_for_request(req, poses: np.ndarray, min_widths_m: np.ndarray | float = 0.0) -> Placement:
+    """:func:`place_grasps` with the request's cloud, support plane, gripper and planner settings
+    (sweep = ``planner.sphere_radius_m``, ``collision_margin_m``, ``width_clearance_m``)."""
+    pl, gr = req.planner, req.gripper
+    return place_grasps(
+        np.asarray(req.points, dtype=np.float64),
+        poses,
+        gr,
+        sweep_m=pl.sphere_radius_m,
+        table_z=req.table_z,
+        margin_m=pl.collision_margin_m,
+        clearance_m=pl.width_clearance_m,
+        max_lift_m=max_lift_m(gr),
+        min_widths_m=min_widths_m,
+    )

@@ -16,7 +16,7 @@ Eq. (1)-(3) as ``optimal`` (its building blocks are reused unchanged). Then:
    land a finger on the object. Above the stroke, the path is rejected.
 3. **Swept-volume collision check.** Each path is checked, in ascending cost, with the finger and palm
    boxes swept along the straight approach against the cloud and against the support plane
-   (:func:`graspexp.planning.collision.place_grasps`; a grasp whose boxes would dip below the plane is
+   (:func:`graspexp.planning.collision.place_for_request`; a grasp whose boxes would dip below the plane is
    first moved back along the approach, by at most 80 % of the fingertip reach). The paper only tests
    the path's start point against the plane, so the palm can hit the object (e.g. a tall object
    grasped low from above) and the fingertips the table.
@@ -30,7 +30,7 @@ plus ``com`` (3,) and ``com_factor`` (K,).
 
 import numpy as np
 
-from graspexp.planning.collision import max_lift_m, place_grasps
+from graspexp.planning.collision import place_for_request
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.optimal import paper_candidates
 from graspexp.planning.pose import grasp_rotations, opening_width_m
@@ -81,17 +81,7 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
         poses = np.tile(np.eye(4), (len(ks), 1, 1))
         poses[:, :3, :3] = grasp_rotations(directions[ks, ps], axis)
         poses[:, :3, 3] = centers[ks]
-        placed = place_grasps(
-            points,
-            poses,
-            gr,
-            sweep_m=pl.sphere_radius_m,
-            table_z=req.table_z,
-            margin_m=pl.collision_margin_m,
-            clearance_m=pl.width_clearance_m,
-            max_lift_m=max_lift_m(gr),
-            min_widths_m=openings[ks],
-        )
+        placed = place_for_request(req, poses, min_widths_m=openings[ks])
         examined += len(ks)
         for key, n in placed.counts().items():
             rejected[key] += n

@@ -101,6 +101,19 @@ _IDENTITY_POSE = {
 }
 
 
+def _entity(id: str, frame_id: str, *, cubes: list[dict], triangles: list[dict]) -> dict:
+    """A foxglove.SceneEntity that never expires and follows ``frame_id`` (frame_locked)."""
+    return {
+        "frame_id": frame_id,
+        "id": id,
+        "lifetime": {"sec": 0, "nsec": 0},
+        "frame_locked": True,
+        "metadata": [],
+        "cubes": cubes,
+        "triangles": triangles,
+    }
+
+
 def mesh_entity(
     id: str, frame_id: str, vertices: np.ndarray, faces: np.ndarray, color: Sequence[float]
 ) -> dict:
@@ -120,14 +133,11 @@ def mesh_entity(
     if f.size and (f.min() < 0 or f.max() >= len(v)):
         raise ValueError(f"faces index outside 0..{len(v) - 1}")
     pts = np.round(v, SCENE_DECIMALS).tolist()
-    return {
-        "frame_id": frame_id,
-        "id": id,
-        "lifetime": {"sec": 0, "nsec": 0},
-        "frame_locked": True,
-        "metadata": [],
-        "cubes": [],
-        "triangles": [
+    return _entity(
+        id,
+        frame_id,
+        cubes=[],
+        triangles=[
             {
                 "pose": _IDENTITY_POSE,
                 "points": [{"x": p[0], "y": p[1], "z": p[2]} for p in pts],
@@ -136,7 +146,7 @@ def mesh_entity(
                 "indices": f.reshape(-1).astype(int).tolist(),
             }
         ],
-    }
+    )
 
 
 def box_entity(
@@ -156,24 +166,15 @@ def box_entity(
     q = np.asarray(quat_xyzw, dtype=float).reshape(-1)
     if q.shape != (4,):
         raise ValueError(f"quat_xyzw must have 4 components, got {quat_xyzw!r}")
-    return {
-        "frame_id": frame_id,
-        "id": id,
-        "lifetime": {"sec": 0, "nsec": 0},
-        "frame_locked": True,
-        "metadata": [],
-        "cubes": [
-            {
-                "pose": {
-                    "position": dict(zip("xyz", c, strict=True)),
-                    "orientation": dict(zip("xyzw", q.tolist(), strict=True)),
-                },
-                "size": dict(zip("xyz", s, strict=True)),
-                "color": _rgba(color),
-            }
-        ],
-        "triangles": [],
+    cube = {
+        "pose": {
+            "position": dict(zip("xyz", c, strict=True)),
+            "orientation": dict(zip("xyzw", q.tolist(), strict=True)),
+        },
+        "size": dict(zip("xyz", s, strict=True)),
+        "color": _rgba(color),
     }
+    return _entity(id, frame_id, cubes=[cube], triangles=[])
 
 
 class TrialWriter:
