@@ -34,7 +34,8 @@ class SimConfig:
     retract_speed_mps: float = 0.25
     """Bin mode pull-back speed, m/s."""
     slip_threshold_m: float = 0.02
-    """Object displacement in the palm frame during the hold above which the grasp slipped, m."""
+    """Slip = how far the grasp point (TCP) moved over the object, in the object frame, between closing
+    and the end of the hold; above this the grasp slipped, m."""
     max_speed_mps: float = 20.0
     """Any body faster than this (or NaN) means the simulation blew up, m/s."""
     log_rate_hz: float = 30.0

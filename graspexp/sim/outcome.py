@@ -48,6 +48,7 @@ class TrialResult:
     """Smallest friction coefficient (of 0.2, 0.4, ..., 1.2) at which the planned grasp's two finger contacts
     are force-closure on the true object pose, without physics; NaN when none is (or the line misses)."""
     slip_m: float = float("nan")
+    """Distance the grasp point slid over the object (object frame) from closing to the end of the hold, m."""
     finger_force_n: list[float] = field(default_factory=list)
     touched_support: bool = False
     timings_s: dict[str, float] = field(default_factory=dict)

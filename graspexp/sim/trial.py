@@ -349,6 +349,12 @@ def _held(sim: _Sim, grasp: Grasp) -> dict[str, float]:
     return finger_forces(sim.ts.scene.get_contacts(), sim.dt, grasp.pose[:3, 1])
 
 
+def _grasp_point_on_object(gripper: Gripper, ts: TrialScene) -> np.ndarray:
+    """(3,) the TCP in the object frame, m: it moves only when the fingers slide over the object (a
+    swing about the grasp point, which leaves the object held, does not count as slip)."""
+    return (np.linalg.inv(ts.object_pose()) @ gripper.tcp_pose())[:3, 3]
+
+
 def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> None:
     cfg = ctx.cfg
     mode, scfg = cfg.mode, cfg.sim
@@ -374,7 +380,7 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
         res.finger_force_n = [forces[n] for n in FINGER_NAMES]
         raise TrialFailed(FailureReason.NO_CONTACT, f"finger forces after closing {forces} N")
 
-    rel0 = np.linalg.inv(gripper.tcp_pose()) @ ts.object_pose()
+    grip0 = _grasp_point_on_object(gripper, ts)
     if mode.remove_support_after_grasp:
         sim.phase("remove_support")
         ts.remove_support()
@@ -393,8 +399,7 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
     sim.run(mode.hold_s)
     forces = _held(sim, grasp)
     res.finger_force_n = [forces[n] for n in FINGER_NAMES]
-    rel1 = np.linalg.inv(gripper.tcp_pose()) @ ts.object_pose()
-    res.slip_m = float(np.linalg.norm(rel1[:3, 3] - rel0[:3, 3]))
+    res.slip_m = float(np.linalg.norm(_grasp_point_on_object(gripper, ts) - grip0))
     touching = [f >= MIN_FINGER_FORCE_N for f in forces.values()]
     if not any(touching):
         raise TrialFailed(
