@@ -54,6 +54,8 @@ def select_objects(cfg: DictConfig) -> list[str]:
             raise DatasetError(f"unknown object(s) {unknown} in dataset {cfg.dataset.name!r}; valid: {names}")
         return list(cfg.objects)
     present = available_objects(cfg.dataset)
+    if not present:
+        load_object(cfg.dataset, names[0], 16, 0)  # raises the DatasetError that names the missing path
     missing = [o for o in names if o not in present]
     if missing:
         log.warning(
@@ -63,8 +65,6 @@ def select_objects(cfg: DictConfig) -> list[str]:
             missing,
             cfg.dataset.name,
         )
-    if not present:
-        load_object(cfg.dataset, names[0], 16, 0)  # raises the DatasetError that names the missing path
     return [o for o in names if o in present]
 
 
