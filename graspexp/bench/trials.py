@@ -23,7 +23,7 @@ from graspexp.seeding import derive_seed
 from graspexp.sim.collision import convex_hulls
 from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
 
-PHASES = ("build", "settle", "plan", "execute", "log")
+PHASES = ("build", "settle", "plan", "quality", "execute", "log")
 
 
 def _run_object(args: tuple[list[str], str, int, str]) -> list[dict]:

@@ -52,7 +52,7 @@ class TrialResult:
     finger_force_n: list[float] = field(default_factory=list)
     touched_support: bool = False
     timings_s: dict[str, float] = field(default_factory=dict)
-    """Wall time per phase (build, settle, plan, execute, log), s; ``physics`` is the part of settle and
+    """Wall time per phase (build, settle, plan, quality, execute, log), s; ``physics`` is the part of settle and
     execute spent inside the physics step itself."""
     sim_time_s: float = 0.0
     steps: int = 0

@@ -261,14 +261,15 @@ def run_trial(ctx: TrialContext) -> TrialResult:
         success=False,
         reason=None,
     )
-    timings = dict.fromkeys(("build", "settle", "plan", "execute", "log", "physics"), 0.0)
+    timings = dict.fromkeys(("build", "settle", "plan", "quality", "execute", "log", "physics"), 0.0)
     sim: _Sim | None = None
     try:
         sim = _drop_until_on_support(ctx, res, timings)
         with sim.timed("plan"):
             grasp = _plan(ctx, sim)
         res.grasp_cost, res.grasp_width_m, res.n_feasible = grasp.cost, grasp.width_m, grasp.n_feasible
-        res.fc_min_mu = _force_closure_mu(ctx, sim, grasp)
+        with sim.timed("quality"):
+            res.fc_min_mu = _force_closure_mu(ctx, sim, grasp)
         with sim.timed("execute"):
             _execute(ctx, sim, grasp, res)
         res.success = True
