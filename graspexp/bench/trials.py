@@ -11,6 +11,7 @@ import statistics
 import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor
+from contextlib import nullcontext
 from pathlib import Path
 
 import numpy as np
@@ -21,13 +22,13 @@ from graspexp.datasets import available_objects, load_object
 from graspexp.record import TrialRecorder
 from graspexp.seeding import derive_seed
 from graspexp.sim.collision import convex_hulls
-from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
+from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial, trial_seed
 
 PHASES = ("build", "settle", "plan", "quality", "execute", "log")
 
 
-def _run_object(args: tuple[list[str], str, int, str]) -> list[dict]:
-    """All trials of one object with MCAP logging into ``out``; returns per-trial timings."""
+def _run_object(args: tuple[list[str], str, int, str | None]) -> list[dict]:
+    """All trials of one object with MCAP logging into ``out`` (None: no logging); per-trial timings."""
     overrides, name, trials, out = args
     threadpool_limits(limits=1)
     cfg = compose_config(overrides)
@@ -37,9 +38,13 @@ def _run_object(args: tuple[list[str], str, int, str]) -> list[dict]:
     rows = []
     for i in range(trials):
         t0 = time.perf_counter()
-        path = Path(out) / name / f"{i:03d}.mcap"
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with TrialRecorder(path, {"object": name}) as rec:
+        if out is None:
+            recorder = nullcontext(NullRecorder())
+        else:
+            path = Path(out) / name / f"{i:03d}.mcap"
+            path.parent.mkdir(parents=True, exist_ok=True)
+            recorder = TrialRecorder(path, {"object": name})
+        with recorder as rec:
             res = run_trial(TrialContext(plain, model, hulls, i, trial_seed(plain, name, i), rec))
         rows.append({"wall": time.perf_counter() - t0, "success": res.success, **res.timings_s})
     return rows
@@ -83,6 +88,11 @@ def main(argv: list[str] | None = None) -> None:
     print(
         f"\noverhead ratio (full trial incl. planning + logging) / (physics steps): median {statistics.median(ratio):.3f}"
         f"  (target <= 1.25)"
+    )
+    bare = [r for n in names for r in _run_object((args.overrides, n, args.trials, None))]
+    print(
+        "overhead ratio without MCAP logging (record=false): median "
+        f"{statistics.median(r['wall'] / r['physics'] for r in bare):.3f}"
     )
     print(f"success: {sum(r['success'] for r in rows)}/{len(rows)}")
     tp = {
