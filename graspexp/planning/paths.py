@@ -69,5 +69,4 @@ def above_support(
     clearance_m: float,
 ) -> np.ndarray:
     """(K, M) bool: True where the path's sphere point is at or above ``z = table_z_m + clearance_m``."""
-    start_z = centers_m[:, None, 2] - sphere_radius_m * directions[..., 2]
-    return start_z >= table_z_m + clearance_m
+    return sphere_points(centers_m, directions, sphere_radius_m)[..., 2] >= table_z_m + clearance_m

@@ -40,8 +40,6 @@ class Gripper:
     palm: sapien.physx.PhysxArticulationLinkComponent
     fingers: tuple[sapien.physx.PhysxArticulationLinkComponent, sapien.physx.PhysxArticulationLinkComponent]
     joints: list
-    root_pose: np.ndarray
-    """(4,4) world pose of the root = grasp frame at zero joint offsets."""
 
     def set_state(self, offset: np.ndarray, half_width_m: float) -> None:
         """Teleport to TCP offset (3,) in the grasp frame, fingers at ``half_width_m``; zero velocity."""
@@ -63,11 +61,6 @@ class Gripper:
     def close(self) -> None:
         """Drive the fingers past closed: each presses with the configured grip force."""
         self.drive_fingers(-CLOSE_PAST_M)
-
-    def finger_opening(self) -> float:
-        """Current distance between the pads, m."""
-        q = self.articulation.get_qpos()
-        return float(q[3] + q[4])
 
     def tcp_pose(self) -> np.ndarray:
         """(4,4) world pose of the TCP (palm link frame)."""
@@ -141,5 +134,4 @@ def build_gripper(
         palm=links[PALM_NAME],
         fingers=(links["finger_left"], links["finger_right"]),
         joints=joints,
-        root_pose=grasp_pose,
     )
