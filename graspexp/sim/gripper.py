@@ -1,11 +1,12 @@
 """The parallel gripper as a SAPIEN articulation built from ``conf/gripper/*``.
 
-Chain: fixed root at the grasp frame's orientation -> prismatic x, y, z (driven, in the grasp frame)
--> ``palm`` (the TCP frame: origin midway between the pads, +Z approach, +Y closing axis)
--> ``finger_left`` (+Y) and ``finger_right`` (-Y), prismatic, force-limited drives.
-A finger joint value q is the distance of that finger's inner face from the TCP along +-Y, metres.
-The gripper only translates during a trial (the paper moves the end effector to the grasp pose and
-then extends / pulls back), so the root carries the grasp orientation and no rotational joints exist.
+Chain: fixed root at the planned grasp frame -> prismatic x, y, z -> revolute roll, pitch, yaw (a driven,
+floating 6-DoF base, expressed in the grasp frame) -> ``palm`` (the TCP frame: origin midway between the
+pads, +Z approach, +Y closing axis) -> ``finger_left`` (+Y) and ``finger_right`` (-Y), prismatic,
+force-limited drives coupled by a fixed tendon. A finger joint value q is the distance of that finger's
+inner face from the TCP along +-Y, metres. Rooting the chain at the grasp frame keeps the rotational
+joints near zero during a trial (no gimbal lock): the protocol holds them at 0 and moves the TCP by
+translation offsets (pre-grasp, extend, pull back, lift), as the paper's end effector does.
 """
 
 from dataclasses import dataclass
@@ -27,6 +28,11 @@ _AXIS_Q = {
 FINGER_NAMES = ("finger_left", "finger_right")
 PALM_NAME = "palm"
 ARM_STIFFNESS, ARM_DAMPING, ARM_FORCE_N = 2.0e4, 4.0e2, 400.0
+"""Translation drives: N/m, N s/m, N."""
+WRIST_STIFFNESS, WRIST_DAMPING, WRIST_TORQUE_NM = 2.0e3, 5.0e1, 200.0
+"""Rotation drives: N m/rad, N m s/rad, N m."""
+N_BASE = 6
+"""Base joints before the two fingers: 3 prismatic then 3 revolute."""
 FINGER_STIFFNESS, FINGER_DAMPING = 2.0e3, 1.0e2
 COUPLING_STIFFNESS, COUPLING_DAMPING = 1.0e5, 1.0e3
 """Fixed tendon that keeps both fingers at the same opening (N/m, N s/m)."""
@@ -43,7 +49,7 @@ class Gripper:
 
     def set_state(self, offset: np.ndarray, half_width_m: float) -> None:
         """Teleport to TCP offset (3,) in the grasp frame, fingers at ``half_width_m``; zero velocity."""
-        q = np.array([*offset, half_width_m, half_width_m], dtype=np.float32)
+        q = np.array([*offset, 0.0, 0.0, 0.0, half_width_m, half_width_m], dtype=np.float32)
         self.articulation.set_qpos(q)
         self.articulation.set_qvel(np.zeros_like(q))
         self.drive_arm(offset)
@@ -55,7 +61,7 @@ class Gripper:
             joint.set_drive_target(float(value))
 
     def drive_fingers(self, half_width_m: float) -> None:
-        for joint in self.joints[3:]:
+        for joint in self.joints[N_BASE:]:
             joint.set_drive_target(float(half_width_m))
 
     def close(self) -> None:
@@ -82,6 +88,13 @@ def build_gripper(
         link.set_joint_name(f"slide_{axis}")
         q = _AXIS_Q[axis]
         link.set_joint_properties("prismatic", [[-1.0, 1.0]], sapien.Pose(q=q), sapien.Pose(q=q))
+        link.set_mass_and_inertia(0.1, sapien.Pose(), [1e-4] * 3)
+    for axis, name in (("x", "roll"), ("y", "pitch"), ("z", "yaw")):
+        link = ab.create_link_builder(link)
+        link.set_name(name)
+        link.set_joint_name(name)
+        q = _AXIS_Q[axis]
+        link.set_joint_properties("revolute", [[-np.pi, np.pi]], sapien.Pose(q=q), sapien.Pose(q=q))
         link.set_mass_and_inertia(0.1, sapien.Pose(), [1e-4] * 3)
     palm = link
     palm.set_name(PALM_NAME)
@@ -116,7 +129,10 @@ def build_gripper(
     joints = list(art.active_joints)
     for j in joints[:3]:
         j.set_drive_properties(stiffness=ARM_STIFFNESS, damping=ARM_DAMPING, force_limit=ARM_FORCE_N)
-    for j in joints[3:]:
+    for j in joints[3:N_BASE]:
+        j.set_drive_properties(stiffness=WRIST_STIFFNESS, damping=WRIST_DAMPING, force_limit=WRIST_TORQUE_NM)
+        j.set_drive_target(0.0)
+    for j in joints[N_BASE:]:
         j.set_drive_properties(
             stiffness=FINGER_STIFFNESS, damping=FINGER_DAMPING, force_limit=float(cfg.grip_force_n)
         )
