@@ -71,26 +71,19 @@ def compose_config(overrides: list[str], config_name: str = "config") -> DictCon
 
 def check_overrides(overrides: list[str], config_name: str = "config") -> None:
     """Compose every combination of the (possibly swept) overrides and validate it; exit 2 on error."""
-    from hydra import compose, initialize_config_dir
     from hydra._internal.core_plugins.basic_sweeper import BasicSweeper
-    from hydra.core.global_hydra import GlobalHydra
     from hydra.core.override_parser.overrides_parser import OverridesParser
 
-    register_configs()
     mine = [o for o in overrides if not o.lstrip("+~").startswith("hydra")]
     try:
         parsed = OverridesParser.create().parse_overrides(mine)
-        combos = [c for batch in BasicSweeper.split_arguments(parsed, None) for c in batch]
-        GlobalHydra.instance().clear()
-        with initialize_config_dir(config_dir=CONF_DIR, version_base="1.3"):
-            for combo in combos:
-                validate(compose(config_name, overrides=combo))
+        for batch in BasicSweeper.split_arguments(parsed, None):
+            for combo in batch:
+                validate(compose_config(combo, config_name))
     except ConfigError as exc:
         fail(str(exc))
     except Exception as exc:  # Hydra/OmegaConf errors: report the reason, not the traceback
         fail(_one_line(exc))
-    finally:
-        GlobalHydra.instance().clear()
 
 
 def fail(message: str) -> None:

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 import trimesh
 from omegaconf import OmegaConf
+from test_planner_common import RG2  # explicit RG2 dimensions, independent of conf/gripper
 
 from graspexp.cli import compose_config
-from graspexp.config import GripperConfig
 from graspexp.planning import Grasp, NoFeasibleGrasp, PlanRequest, get_planner, plan
 from graspexp.planning.collision import cloud_hits, frame_from_axes, gripper_boxes, lowest_z
 
@@ -148,18 +148,6 @@ def test_obb_closes_across_the_narrow_side_from_above() -> None:
     narrow = np.array([-np.sin(0.6), np.cos(0.6), 0.0])
     assert abs(g.pose[:3, 1] @ narrow) == pytest.approx(1.0, abs=1e-3)
     assert g.width_m == pytest.approx(0.05 + 2 * 0.005, abs=2e-3)
-
-
-# Explicit dimensions (the OnRobot RG2 of the paper), so these tests do not move with conf/gripper.
-RG2 = GripperConfig(
-    name="rg2_test",
-    max_width_m=0.11,
-    grip_force_n=40.0,
-    finger_length_m=0.055,
-    finger_width_m=0.022,
-    finger_thickness_m=0.01,
-    palm_size_m=[0.045, 0.15, 0.06],
-)
 
 
 def _plan_with(name: str, pts, normals, area) -> Grasp:
