@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from scipy.spatial import cKDTree
+from sklearn.neighbors import KDTree
 
 from graspexp.planning.clusters import AUTO_K_STROKE_FRACTION, choose_k, main_axis, segment
 from graspexp.planning.paths import above_support, approach_directions, fibonacci_sphere, sphere_points
@@ -21,7 +21,7 @@ def test_fibonacci_points_are_unit(m):
 def test_fibonacci_points_are_evenly_spread(m):
     u = fibonacci_sphere(m)
     assert np.linalg.norm(u.mean(axis=0)) < 2.0 / m
-    nn, _ = cKDTree(u).query(u, k=2)
+    nn, _ = KDTree(u).query(u, k=2)
     nn = nn[:, 1]
     assert nn.max() / nn.min() < 1.6
     # An ideal packing gives about sqrt(4 pi / m) between neighbours.

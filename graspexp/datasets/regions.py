@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 import trimesh
 import yaml
-from scipy.spatial import cKDTree
+from sklearn.neighbors import KDTree
 
 from graspexp.datasets.errors import DatasetError
 
@@ -246,12 +246,12 @@ def import_meshlab_area(
     area = np.asarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=float) * float(scale)
     if len(area) < 2 or not np.all(np.isfinite(area)):
         raise DatasetError(f"MeshLab area file {path} needs at least 2 finite points, has {len(area)}")
-    tree = cKDTree(area)
+    tree = KDTree(area)
     if tolerance_m is None:
         spacing, _ = tree.query(area, k=2)
         tolerance_m = MESHLAB_TOLERANCE_FACTOR * float(np.median(spacing[:, 1]))
-    distance, _ = tree.query(np.asarray(object_points, dtype=float), k=1)
-    return distance <= tolerance_m
+    distance, _ = tree.query(np.asarray(object_points, dtype=float).reshape(-1, 3), k=1)
+    return distance[:, 0] <= tolerance_m
 
 
 def area_mask(

@@ -1,4 +1,4 @@
-"""Grasp planning: pure numpy + scikit-learn, no simulator import.
+"""Grasp planning: pure numpy, no simulator import.
 
 ``plan(req)`` dispatches on ``req.planner.name`` through :data:`PLANNERS`; ``optimal`` is the paper's
 strategy (section III, :mod:`graspexp.planning.optimal`).

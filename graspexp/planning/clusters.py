@@ -22,8 +22,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from sklearn import config_context
-from sklearn.cluster import kmeans_plusplus
 
 AUTO_K_STROKE_FRACTION = 0.5
 """Default ``c`` in the ``k: auto`` rule (``planner.auto_k_stroke_fraction``): one cluster per
@@ -33,8 +31,8 @@ KMEANS_MAX_ITER = 100
 """Lloyd iterations cap."""
 
 KMEANS_TOL = 1e-3
-"""Relative tolerance (sklearn's definition): stop once the centres move less than about sqrt(1e-3) (~3 %) of the
-area's RMS spread per iteration (about 1 mm on these objects); sklearn's 1e-4 costs 3-4x the iterations."""
+"""Relative tolerance (scikit-learn's definition): stop once the centres move less than about sqrt(1e-3) (~3 %) of the
+area's RMS spread per iteration (about 1 mm on these objects); scikit-learn's 1e-4 costs 3-4x the iterations."""
 
 
 def main_axis(points_m: np.ndarray) -> np.ndarray:
@@ -43,8 +41,11 @@ def main_axis(points_m: np.ndarray) -> np.ndarray:
     A single point (or a degenerate cloud) still yields a unit vector (eigh's output for a zero matrix).
     """
     pts = np.asarray(points_m, dtype=np.float64)
-    centred = pts - pts.mean(axis=0)
-    cov = centred.T @ centred / max(len(pts), 1)
+    n = max(len(pts), 1)
+    mean = np.ones(len(pts)) @ pts / n
+    # E[x x^T] - mean mean^T: BLAS products instead of centring, as numpy is slow on (n, 3) broadcasts;
+    # for clouds within a metre of the origin the cancellation costs < 1e-12 relative.
+    cov = pts.T @ pts / n - np.outer(mean, mean)
     _, vecs = np.linalg.eigh(cov)
     axis = vecs[:, -1]
     axis = axis / np.linalg.norm(axis)
@@ -94,33 +95,77 @@ class Clusters:
     labels: np.ndarray
 
 
-def _means(pts: np.ndarray, labels: np.ndarray, k: int, fallback: np.ndarray | None = None) -> np.ndarray:
-    """(k, 3) mean of each label's points; an empty label keeps its ``fallback`` row."""
-    onehot = (labels[:, None] == np.arange(k)).astype(np.float64)  # (n, k)
-    counts = onehot.sum(axis=0)
-    out = (onehot.T @ pts) / np.maximum(counts, 1.0)[:, None]
-    if fallback is not None:
+def _means(pts_1: np.ndarray, labels: np.ndarray, k: int, fallback: np.ndarray | None = None) -> np.ndarray:
+    """(k, 3) mean of each label's points; an empty label keeps its ``fallback`` row.
+
+    pts_1 : (n, 4) points with a column of ones, so one product gives the sums and the counts.
+    """
+    sums = (labels == np.arange(k)[:, None]).astype(np.float64) @ pts_1  # (k, 4)
+    counts = sums[:, 3]
+    out = sums[:, :3] / np.maximum(counts, 1.0)[:, None]
+    if fallback is not None and counts.min() == 0:
         out[counts == 0] = fallback[counts == 0]
     return out
 
 
+def _nearest(pts_1t: np.ndarray, centers: np.ndarray) -> np.ndarray:
+    """(n,) index of the centre nearest each point, lowest index on ties: argmin_j (|c_j|^2 - 2 c_j . x),
+    one product with the (4, n) points-and-ones ``pts_1t``. A loop over the few centres beats
+    ``argmin(axis=0)``."""
+    dist = np.hstack([centers * -2.0, np.sum(centers * centers, axis=1, keepdims=True)]) @ pts_1t  # (k, n)
+    best = dist[0]
+    labels = np.zeros(dist.shape[1], dtype=np.int64)
+    for j in range(1, len(dist)):
+        closer = dist[j] < best
+        labels[closer] = j
+        np.minimum(best, dist[j], out=best)
+    return labels
+
+
+def _kmeans_plusplus(pts_t: np.ndarray, k: int, rng: np.random.Generator) -> np.ndarray:
+    """Greedy k-means++ seeding (Arthur & Vassilvitskii 2007, the variant scikit-learn uses): the first
+    centre uniformly, then each next one the best, by resulting potential, of ``2 + floor(ln k)`` points
+    drawn with probability proportional to their squared distance to the nearest chosen centre.
+
+    scikit-learn's ``kmeans_plusplus`` runs the same algorithm behind about 0.8 ms of input validation
+    per call, a sixth of this planner's whole budget (``python -m graspexp.bench.plan_latency``).
+    pts_t : (3, n) points. Returns (k, 3) centres, points of the set.
+    """
+    n_trials = 2 + int(np.log(k))
+    n = pts_t.shape[1]
+    sq_norms = np.einsum("ij,ij->j", pts_t, pts_t)
+
+    def sq_distances(idx: np.ndarray) -> np.ndarray:  # (len(idx), n) squared distances, clipped at 0
+        c = pts_t[:, idx]
+        dist = (c.T * -2.0) @ pts_t + sq_norms + sq_norms[idx][:, None]
+        return np.maximum(dist, 0.0, out=dist)
+
+    chosen = [int(rng.integers(n))]
+    closest = sq_distances(np.array(chosen))[0]  # to the nearest chosen centre
+    for _ in range(1, k):
+        draws = rng.random(n_trials) * closest.sum()
+        cand = np.minimum(np.searchsorted(np.cumsum(closest), draws), n - 1)
+        dist = np.minimum(sq_distances(cand), closest)  # (n_trials, n)
+        best = int(np.argmin(dist.sum(axis=1)))
+        closest = dist[best]
+        chosen.append(int(cand[best]))
+    return pts_t[:, chosen].T.copy()
+
+
 def _lloyd(pts: np.ndarray, k: int, random_state: int) -> tuple[np.ndarray, np.ndarray]:
-    """K-means: scikit-learn's seeded greedy k-means++ initialisation, then Lloyd iterations in numpy
-    (scikit-learn's ``KMeans`` object costs 1.5-3 ms of fixed overhead on these ~1000-point clouds).
-    Stops when the centres move less than ``KMEANS_TOL`` x the mean per-axis variance (sklearn's rule)."""
-    with config_context(assume_finite=True, skip_parameter_validation=True):
-        centers, _ = kmeans_plusplus(pts, k, random_state=random_state)
-    tol = KMEANS_TOL * float(np.var(pts, axis=0).mean())
+    """K-means: seeded greedy k-means++ (:func:`_kmeans_plusplus`), then Lloyd iterations. Stops when
+    the centres move less than ``KMEANS_TOL`` x the mean per-axis variance (scikit-learn's rule)."""
+    pts_1 = np.hstack([pts, np.ones((len(pts), 1))])  # (n, 4)
+    pts_1t = np.ascontiguousarray(pts_1.T)
+    centers = _kmeans_plusplus(pts_1t[:3], k, np.random.default_rng(random_state))
+    tol = KMEANS_TOL * float(np.var(pts_1t[:3], axis=1).mean())
     for _ in range(KMEANS_MAX_ITER):
-        # argmin_j |x - c_j|^2 = argmin_j (|c_j|^2 - 2 x . c_j): |x|^2 is the same for every j
-        labels = (np.sum(centers * centers, axis=1) - 2.0 * pts @ centers.T).argmin(axis=1)
-        new = _means(pts, labels, k, fallback=centers)
-        shift = float(np.sum((new - centers) ** 2))
+        new = _means(pts_1, _nearest(pts_1t, centers), k, fallback=centers)
+        step = (new - centers).ravel()
         centers = new
-        if shift <= tol:
+        if step @ step <= tol:
             break
-    labels = (np.sum(centers * centers, axis=1) - 2.0 * pts @ centers.T).argmin(axis=1)
-    return labels.astype(np.int64), centers
+    return _nearest(pts_1t, centers), centers
 
 
 def segment(area_points_m: np.ndarray, k: int, *, random_state: int) -> Clusters:
@@ -134,10 +179,11 @@ def segment(area_points_m: np.ndarray, k: int, *, random_state: int) -> Clusters
         centers = pts.mean(axis=0, keepdims=True)
     else:
         labels, centers = _lloyd(pts, k, random_state)
-        # Drop clusters left empty (only possible with fewer distinct points than k) and renumber.
-        used, labels = np.unique(labels, return_inverse=True)
-        k = len(used)
-        centers = _means(pts, labels, k)
+        if np.bincount(labels, minlength=k).min() == 0:
+            # Drop clusters left empty (only possible with fewer distinct points than k) and renumber.
+            used, labels = np.unique(labels, return_inverse=True)
+            k = len(used)
+        centers = _means(np.hstack([pts, np.ones((len(pts), 1))]), labels, k)
     sq = np.sum((pts - centers[labels]) ** 2, axis=1)
     counts = np.bincount(labels, minlength=k)
     radii = np.sqrt(np.bincount(labels, weights=sq, minlength=k) / np.maximum(counts, 1))

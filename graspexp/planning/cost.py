@@ -18,7 +18,7 @@ with every constant taken from :class:`graspexp.config.CostConfig`.
 ``Y_ip`` uses ``Y^2 = |x - c|^2 - ((x - c) . d)^2`` (``d`` unit), one matrix product per cluster. The
 per-element work runs in float32 on coordinates relative to the centre (mm): the squared-distance
 cancellation then loses at most ~1e-3 mm^2, which changes a summand by far less than 1e-4; sums
-use numpy's pairwise float32 summation (relative error ~1e-7). :func:`distance_term` with ``dtype=np.float64`` is the exact reference.
+are float32 BLAS dot products (relative error ~1e-6). :func:`distance_term` with ``dtype=np.float64`` is the exact reference.
 """
 
 import numpy as np
@@ -89,10 +89,11 @@ def distance_term(
     np.square(block, out=block)
     block += dtype(cost.distance_offset_mm2)
     np.divide(dtype(cost.distance_numerator_mm2), block, out=block)
-    # A row operand, not a scalar: numpy's scalar-broadcast minimum is several times slower here.
+    # Row operands, not scalars: numpy's scalar-broadcast minimum is several times slower here, and the
+    # BLAS product with a ones vector sums 3x faster than ``block.sum(axis=1)`` (its SIMD partial sums
+    # keep the float32 relative error near 1e-6).
     np.minimum(block, np.full(n, cost.distance_cap, dtype=dtype), out=block)
-    # numpy's pairwise summation along the contiguous axis keeps the float32 sum accurate (~1e-7).
-    return block.sum(axis=1).astype(np.float64)
+    return (block @ np.ones(n, dtype=dtype)).astype(np.float64)
 
 
 def cluster_costs(
@@ -119,7 +120,8 @@ def cluster_costs(
     """
     if mode not in ("collab", "bin"):
         raise ValueError(f"mode={mode!r} is invalid: expected one of collab, bin")
-    rel_mm = (np.asarray(points_m, dtype=np.float64) - center_m) * M_TO_MM
+    # (3, N) arithmetic, viewed back as (N, 3): numpy is slow on (N, 3) broadcasts.
+    rel_mm = ((np.asarray(points_m, dtype=np.float64).T - np.asarray(center_m)[:, None]) * M_TO_MM).T
     j = angle_term(path_main_axis_angles_deg(directions, axis), cost)
     j = j * distance_term(rel_mm, directions, r_k_m * M_TO_MM, cost, dtype=dtype)
     if mode == "bin":

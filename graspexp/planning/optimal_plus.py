@@ -33,7 +33,7 @@ import numpy as np
 from graspexp.planning.collision import place_for_request
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.optimal import paper_candidates
-from graspexp.planning.pose import grasp_rotations, opening_width_m
+from graspexp.planning.pose import grasp_rotations, opening_widths_m
 from graspexp.planning.request import PlanRequest, PlanResult
 
 NAME = "optimal_plus"
@@ -70,7 +70,7 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
     k, m = cand.costs.shape
     factors, com = com_factors(centers, points, pl.com_weight)
     costs = factors[:, None] * cand.costs
-    openings = np.array([opening_width_m(float(r), pl.width_margin, gr) for r in radii])
+    openings = opening_widths_m(radii, pl.width_margin, gr)
 
     order = np.argsort(costs, axis=None, kind="stable")[: int(feasible.sum())]
     rejected = {"n_too_wide": 0, "n_below_support": 0, "n_collides": 0}

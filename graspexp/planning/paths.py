@@ -11,12 +11,15 @@ lies above the plane (it is a mean of surface points of an object standing on it
 then above the plane exactly when the sphere point is.
 """
 
+from functools import lru_cache
+
 import numpy as np
 
 GOLDEN_ANGLE_RAD = np.pi * (3.0 - np.sqrt(5.0))
 """Azimuth increment of the Fibonacci lattice, radians (about 137.5 degrees)."""
 
 
+@lru_cache(maxsize=8)
 def fibonacci_sphere(m: int) -> np.ndarray:
     """``m`` evenly spread unit vectors.
 
@@ -25,7 +28,7 @@ def fibonacci_sphere(m: int) -> np.ndarray:
 
     Returns
     -------
-    (m, 3) float64 unit vectors (norm 1 to rounding).
+    (m, 3) float64 unit vectors (norm 1 to rounding), read-only (the lattice is cached per ``m``).
     """
     if m < 1:
         raise ValueError(f"m={m!r} is invalid: expected a positive number of paths")
@@ -33,7 +36,9 @@ def fibonacci_sphere(m: int) -> np.ndarray:
     z = 1.0 - (2.0 * i + 1.0) / m
     rho = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
     theta = i * GOLDEN_ANGLE_RAD
-    return np.stack([rho * np.cos(theta), rho * np.sin(theta), z], axis=1)
+    lattice = np.stack([rho * np.cos(theta), rho * np.sin(theta), z], axis=1)
+    lattice.flags.writeable = False
+    return lattice
 
 
 def approach_directions(centers_m: np.ndarray, m: int) -> np.ndarray:

@@ -6,7 +6,7 @@ from collections.abc import Iterable
 import numpy as np
 
 Z_95 = 1.959963984540054
-"""Two-sided 95 % standard-normal quantile (scipy.stats.norm.ppf(0.975))."""
+"""Two-sided 95 % standard-normal quantile (the inverse normal CDF at 0.975)."""
 
 
 def wilson_interval(successes: int, trials: int, z: float = Z_95) -> tuple[float, float]:
