@@ -150,35 +150,37 @@ def test_obb_closes_across_the_narrow_side_from_above() -> None:
     assert g.width_m == pytest.approx(0.05 + 2 * 0.005, abs=2e-3)
 
 
-def _plan_with(name: str, pts, normals, area) -> Grasp:
+def _plan_with(name: str, pts, normals, area, seed: int = 1) -> Grasp:
     c = _cfg(name, "bin")
-    return plan(PlanRequest(pts, normals, area, np.eye(4), TABLE_Z, "bin", RG2, c.planner, c.cost, 1)).grasp
+    return plan(PlanRequest(pts, normals, area, np.eye(4), TABLE_Z, "bin", RG2, c.planner, c.cost, seed)).grasp
 
 
 def test_optimal_plus_avoids_the_palm_collision_that_optimal_accepts() -> None:
-    # A can (r 33 mm, 100 mm tall) whose grasping area is its lower 60 mm: the paper's planner grasps the
-    # area's centre nearly straight from above, with the palm inside the can.
+    # A can (r 33 mm, 100 mm tall) whose grasping area is its lower 60 mm: depending on the K-means seed the
+    # paper's planner grasps the area's centre nearly straight from above, with the palm inside the can.
     pts, normals = _cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
     area = pts[:, 2] < TABLE_Z + 0.06
-    hits = {}
-    for name in ("optimal", "optimal_plus"):
-        g = _plan_with(name, pts, normals, area)
-        hits[name] = cloud_hits(pts, g.pose[None], RG2, g.width_m, sweep_m=0.1, margin_m=0.0)[0]
-    assert hits["optimal"] > 0
-    assert hits["optimal_plus"] == 0
+    hits = {name: [] for name in ("optimal", "optimal_plus")}
+    for seed in range(8):
+        for name, found in hits.items():
+            g = _plan_with(name, pts, normals, area, seed)
+            found.append(cloud_hits(pts, g.pose[None], RG2, g.width_m, sweep_m=0.1, margin_m=0.0)[0])
+    assert sum(h > 0 for h in hits["optimal"]) >= 3
+    assert not any(hits["optimal_plus"])
 
 
 def test_optimal_plus_keeps_the_fingers_out_of_the_table_where_optimal_does_not() -> None:
-    # The same can, whole surface as area: the paper's planner closes from the side so low that the
-    # lower finger corner dips below the table top (only its sphere point is tested).
+    # The same can, whole surface as area: on some K-means seeds the paper's planner closes from the side so
+    # low that the lower finger corner dips below the table top (only its sphere point is tested).
     pts, normals = _cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
     area = np.ones(len(pts), bool)
-    low = {}
-    for name in ("optimal", "optimal_plus"):
-        g = _plan_with(name, pts, normals, area)
-        low[name] = lowest_z(g.pose[None], RG2, g.width_m, 0.1)[0]
-    assert low["optimal"] < TABLE_Z
-    assert low["optimal_plus"] >= TABLE_Z
+    low = {name: [] for name in ("optimal", "optimal_plus")}
+    for seed in range(8):
+        for name, found in low.items():
+            g = _plan_with(name, pts, normals, area, seed)
+            found.append(lowest_z(g.pose[None], RG2, g.width_m, 0.1)[0])
+    assert sum(z < TABLE_Z for z in low["optimal"]) >= 2
+    assert min(low["optimal_plus"]) >= TABLE_Z
 
 
 def test_cloud_hits_counts_points_in_fingers_and_palm_only() -> None:
