@@ -152,7 +152,9 @@ def test_obb_closes_across_the_narrow_side_from_above() -> None:
 
 def _plan_with(name: str, pts, normals, area, seed: int = 1) -> Grasp:
     c = _cfg(name, "bin")
-    return plan(PlanRequest(pts, normals, area, np.eye(4), TABLE_Z, "bin", RG2, c.planner, c.cost, seed)).grasp
+    return plan(
+        PlanRequest(pts, normals, area, np.eye(4), TABLE_Z, "bin", RG2, c.planner, c.cost, seed)
+    ).grasp
 
 
 def test_optimal_plus_avoids_the_palm_collision_that_optimal_accepts() -> None:
