@@ -112,7 +112,10 @@ def _nearest(pts_1t: np.ndarray, centers: np.ndarray) -> np.ndarray:
     """(n,) index of the centre nearest each point, lowest index on ties: argmin_j (|c_j|^2 - 2 c_j . x),
     one product with the (4, n) points-and-ones ``pts_1t``. A loop over the few centres beats
     ``argmin(axis=0)``."""
-    dist = np.hstack([centers * -2.0, np.sum(centers * centers, axis=1, keepdims=True)]) @ pts_1t  # (k, n)
+    coef = np.empty((len(centers), 4))
+    coef[:, :3] = centers * -2.0
+    coef[:, 3] = np.einsum("ij,ij->i", centers, centers)
+    dist = coef @ pts_1t  # (k, n)
     best = dist[0]
     labels = np.zeros(dist.shape[1], dtype=np.int64)
     for j in range(1, len(dist)):
