@@ -24,6 +24,21 @@ _VALUE_FLAGS = {
 }
 
 
+_MODE_FLAGS = {
+    "--run": "--run",
+    "-r": "--run",
+    "--multirun": "--multirun",
+    "-m": "--multirun",
+    "--cfg": "--cfg",
+    "-c": "--cfg",
+    "--info": "--info",
+    "-i": "--info",
+    "--shell-completion": "--shell-completion",
+    "-sc": "--shell-completion",
+}
+"""Hydra's mutually exclusive modes (its own check raises a traceback), short flag -> name."""
+
+
 def split_argv(argv: list[str]) -> list[str]:
     """The override tokens of a Hydra command line (flags and their values removed)."""
     out, skip = [], False
@@ -95,6 +110,9 @@ def fail(message: str) -> None:
 def run_checked(hydra_main: Callable[[], object], argv: list[str] | None = None) -> None:
     """Check the command line's overrides, then hand over to the Hydra main function."""
     argv = sys.argv[1:] if argv is None else argv
+    modes = sorted({_MODE_FLAGS[a] for a in argv if a in _MODE_FLAGS})
+    if len(modes) > 1:
+        fail(f"{' and '.join(modes)} cannot be combined: give only one of --run, --multirun, --cfg, --info")
     if not any(a in ("--help", "-h", "--hydra-help", "--info", "-i") for a in argv):
         check_overrides(split_argv(argv))
     hydra_main()

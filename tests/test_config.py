@@ -85,6 +85,11 @@ def test_out_of_range_values_name_the_key(override, message):
             "graspexp: error: In 'config': Could not find 'rot/q'; Available options in 'rot': xyz, z",
         ),
         (["trials=-2"], "graspexp: error: trials=-2 is invalid: expected a positive integer"),
+        (
+            ["-m", "--cfg", "job", "mode=bin"],
+            "graspexp: error: --cfg and --multirun cannot be combined: give only one of --run, --multirun, "
+            "--cfg, --info",
+        ),
     ],
 )
 def test_bad_override_is_one_line_and_exit_2(args, line):
