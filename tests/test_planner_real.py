@@ -123,3 +123,16 @@ def test_figures_cli_writes_the_pngs(tmp_path):
         "fig09_grasp_pose.png",
     ]
     assert all((tmp_path / n).stat().st_size > 10_000 for n in names)
+
+
+def test_plan_latency_bench_prints_a_row_per_object_and_mode(capsys):
+    from graspexp.bench.plan_latency import MODES, main
+    from graspexp.plan import compose
+
+    assert main(["--repeats", "2", "--runs", "2", "dataset=primitives", "planner.m=64"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    objects = list(compose(["dataset=primitives"]).dataset.objects)
+    rows = [ln.split() for ln in out if ln.split() and ln.split()[0] in objects]
+    assert [(r[0], r[1]) for r in rows] == [(o, m) for o in objects for m in MODES]
+    assert all(float(r[4]) > 0 and float(r[5]) >= float(r[4]) for r in rows)  # p50 > 0, p95 >= p50
+    assert out[-1].startswith("median p50 over objects and modes:") and f"of {len(rows)} over" in out[-1]
