@@ -8,7 +8,9 @@ Each object stands upright on the support as in :mod:`graspexp.plan` (N = ``plan
 2048; M = ``planner.m``, default 256), in each mode. One repeat times ``--runs`` plans after a warm-up
 and takes their p50 and p95; the table shows the median over repeats of each. BLAS/OpenMP run on one
 thread (``OMP_NUM_THREADS=1`` and friends set before numpy loads, and threadpoolctl). ``vs paper`` is
-p50 / 100 ms. Without the YCB meshes under the data root it falls back to the procedural
+p50 / 100 ms. Two more columns split the plan: ``K-means`` (:func:`graspexp.planning.clusters.segment`)
+and ``Eq.1-3`` (:func:`graspexp.planning.cost.cluster_costs` over every path above the support), each the
+same median of per-repeat p50s. Without the YCB meshes under the data root it falls back to the procedural
 ``primitives`` dataset and says so. Extra ``key=value`` arguments are Hydra overrides.
 """
 
@@ -20,13 +22,16 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import argparse  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
-from collections.abc import Sequence  # noqa: E402
+from collections.abc import Callable, Sequence  # noqa: E402
 
 import numpy as np  # noqa: E402
 from threadpoolctl import threadpool_limits  # noqa: E402
 
 from graspexp.plan import CliError, compose, load, upright_request  # noqa: E402
-from graspexp.planning import plan  # noqa: E402
+from graspexp.planning import PlanRequest, plan  # noqa: E402
+from graspexp.planning.clusters import segment  # noqa: E402
+from graspexp.planning.cost import cluster_costs  # noqa: E402
+from graspexp.planning.optimal import kmeans_random_state, paper_candidates  # noqa: E402
 
 PAPER_PLAN_S = 0.1
 """The paper's planner time (clusters + paths + cost), seconds (IV-F, i7-9700)."""
@@ -36,14 +41,32 @@ TARGET_P50_MS = 5.0
 """The issue's target for the p50 of each object, one core, ms."""
 
 
-def time_runs(req, runs: int) -> tuple[float, float]:
-    """p50 and p95 of ``runs`` plan times of ``req``, ms."""
+def time_runs(fn: Callable[[], object], runs: int) -> tuple[float, float]:
+    """p50 and p95 of ``runs`` calls of ``fn``, ms."""
     times = np.empty(runs)
     for i in range(runs):
         start = time.perf_counter()
-        plan(req)
+        fn()
         times[i] = time.perf_counter() - start
     return float(np.percentile(times, 50) * 1e3), float(np.percentile(times, 95) * 1e3)
+
+
+def timed_calls(req: PlanRequest) -> list[Callable[[], object]]:
+    """The whole plan, its K-means and its Eq. (1)-(3) evaluation, as calls on ``req`` (paper planner)."""
+    cand = paper_candidates(req, "bench")
+    area = cand.points[cand.area_mask]
+    k, seed = len(cand.clusters.centers_m), kmeans_random_state(req.seed, req.planner.seed)
+    centers, radii = cand.clusters.centers_m, cand.clusters.radii_m
+
+    def costs() -> None:
+        for j in range(k):
+            ok = cand.feasible[j]
+            cluster_costs(
+                cand.points, centers[j], radii[j], cand.directions[j, ok], cand.axis, req.mode,
+                req.table_z, req.gripper.max_width_m, req.cost,
+            )  # fmt: skip
+
+    return [lambda: plan(req), lambda: segment(area, k, random_state=seed), costs]
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -77,19 +100,29 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"plan latency, {dataset}, N={cfg.planner.n_points} M={cfg.planner.m} gripper={cfg.gripper.name}, "
         f"1 thread, {args.repeats} round-robin repeats x {args.runs} runs (median of per-repeat p50/p95)"
     )
-    timings = np.empty((args.repeats, len(rows), 2))
+    calls = [timed_calls(req) for *_, req in rows]
+    timings = np.empty((args.repeats, len(rows), len(calls[0]), 2))  # repeat, row, call, (p50, p95)
     with threadpool_limits(limits=1):
-        for *_, req in rows:
-            for _ in range(WARMUP_RUNS):
-                plan(req)
+        for row_calls in calls:
+            for fn in row_calls:
+                for _ in range(WARMUP_RUNS):
+                    fn()
         # Round-robin: a slow spell of this shared machine then hits every object, not one.
         for r in range(args.repeats):
-            for i, (*_, req) in enumerate(rows):
-                timings[r, i] = time_runs(req, args.runs)
-    p50, p95 = np.median(timings, axis=0).T
-    print(f"{'object':<26}{'mode':<8}{'K':>3}{'area':>6}{'p50 ms':>9}{'p95 ms':>9}{'vs paper':>10}")
-    for (name, mode, k, area, _), a, b in zip(rows, p50, p95, strict=True):
-        print(f"{name:<26}{mode:<8}{k:>3}{area:>6}{a:>9.2f}{b:>9.2f}{a / (PAPER_PLAN_S * 1e3):>10.3f}")
+            for i, row_calls in enumerate(calls):
+                for c, fn in enumerate(row_calls):
+                    timings[r, i, c] = time_runs(fn, args.runs)
+    median = np.median(timings, axis=0)  # (row, call, 2)
+    p50, p95 = median[:, 0, 0], median[:, 0, 1]
+    print(
+        f"{'object':<26}{'mode':<8}{'K':>3}{'area':>6}{'p50 ms':>9}{'p95 ms':>9}{'vs paper':>10}"
+        f"{'K-means':>9}{'Eq.1-3':>8}"
+    )
+    for (name, mode, k, area, _), m in zip(rows, median, strict=True):
+        print(
+            f"{name:<26}{mode:<8}{k:>3}{area:>6}{m[0, 0]:>9.2f}{m[0, 1]:>9.2f}"
+            f"{m[0, 0] / (PAPER_PLAN_S * 1e3):>10.3f}{m[1, 0]:>9.2f}{m[2, 0]:>8.2f}"
+        )
     overall = float(np.median(p50))
     print(
         f"median p50 over objects and modes: {overall:.2f} ms = {overall / (PAPER_PLAN_S * 1e3):.3f} x the "

@@ -95,52 +95,20 @@ class Clusters:
     labels: np.ndarray
 
 
-def _means(pts_1: np.ndarray, labels: np.ndarray, k: int, fallback: np.ndarray | None = None) -> np.ndarray:
-    """(k, 3) mean of each label's points; an empty label keeps its ``fallback`` row.
-
-    pts_1 : (n, 4) points with a column of ones, so one product gives the sums and the counts.
-    """
-    sums = (labels == np.arange(k)[:, None]).astype(np.float64) @ pts_1  # (k, 4)
-    counts = sums[:, 3]
-    out = sums[:, :3] / np.maximum(counts, 1.0)[:, None]
-    if fallback is not None and counts.min() == 0:
-        out[counts == 0] = fallback[counts == 0]
-    return out
-
-
-def _nearest(pts_1t: np.ndarray, centers: np.ndarray) -> np.ndarray:
-    """(n,) index of the centre nearest each point, lowest index on ties: argmin_j (|c_j|^2 - 2 c_j . x),
-    one product with the (4, n) points-and-ones ``pts_1t``. A loop over the few centres beats
-    ``argmin(axis=0)``."""
-    coef = np.empty((len(centers), 4))
-    coef[:, :3] = centers * -2.0
-    coef[:, 3] = np.einsum("ij,ij->i", centers, centers)
-    dist = coef @ pts_1t  # (k, n)
-    best = dist[0]
-    labels = np.zeros(dist.shape[1], dtype=np.int64)
-    for j in range(1, len(dist)):
-        closer = dist[j] < best
-        labels[closer] = j
-        np.minimum(best, dist[j], out=best)
-    return labels
-
-
-def _kmeans_plusplus(pts_t: np.ndarray, k: int, rng: np.random.Generator) -> np.ndarray:
+def _kmeans_plusplus(pts_t: np.ndarray, sq_norms: np.ndarray, k: int, rng: np.random.Generator) -> np.ndarray:
     """Greedy k-means++ seeding (Arthur & Vassilvitskii 2007, the variant scikit-learn uses): the first
     centre uniformly, then each next one the best, by resulting potential, of ``2 + floor(ln k)`` points
     drawn with probability proportional to their squared distance to the nearest chosen centre.
 
     scikit-learn's ``kmeans_plusplus`` runs the same algorithm behind about 0.8 ms of input validation
     per call, a sixth of this planner's whole budget (``python -m graspexp.bench.plan_latency``).
-    pts_t : (3, n) points. Returns (k, 3) centres, points of the set.
+    pts_t : (3, n) points; sq_norms : (n,) their squared norms. Returns (k, 3) centres, points of the set.
     """
     n_trials = 2 + int(np.log(k))
     n = pts_t.shape[1]
-    sq_norms = np.einsum("ij,ij->j", pts_t, pts_t)
 
     def sq_distances(idx: np.ndarray) -> np.ndarray:  # (len(idx), n) squared distances, clipped at 0
-        c = pts_t[:, idx]
-        dist = (c.T * -2.0) @ pts_t + sq_norms + sq_norms[idx][:, None]
+        dist = (pts_t[:, idx].T * -2.0) @ pts_t + sq_norms + sq_norms[idx][:, None]
         return np.maximum(dist, 0.0, out=dist)
 
     chosen = [int(rng.integers(n))]
@@ -155,39 +123,53 @@ def _kmeans_plusplus(pts_t: np.ndarray, k: int, rng: np.random.Generator) -> np.
     return pts_t[:, chosen].T.copy()
 
 
-def _lloyd(pts: np.ndarray, k: int, random_state: int) -> tuple[np.ndarray, np.ndarray]:
-    """K-means: seeded greedy k-means++ (:func:`_kmeans_plusplus`), then Lloyd iterations. Stops when
-    the centres move less than ``KMEANS_TOL`` x the mean per-axis variance (scikit-learn's rule)."""
-    pts_1 = np.hstack([pts, np.ones((len(pts), 1))])  # (n, 4)
-    pts_1t = np.ascontiguousarray(pts_1.T)
-    centers = _kmeans_plusplus(pts_1t[:3], k, np.random.default_rng(random_state))
-    tol = KMEANS_TOL * float(np.var(pts_1t[:3], axis=1).mean())
-    for _ in range(KMEANS_MAX_ITER):
-        new = _means(pts_1, _nearest(pts_1t, centers), k, fallback=centers)
-        step = (new - centers).ravel()
-        centers = new
-        if step @ step <= tol:
-            break
-    return _nearest(pts_1t, centers), centers
+def _cluster_sums(aug: np.ndarray, aug_t: np.ndarray, centers: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Assign every point to its nearest centre (lowest index on ties) and sum per cluster.
+
+    aug : (n, 5) rows ``[x, y, z, 1, |p|^2]``; aug_t : (4, n) its first four columns, transposed;
+    centers : (k, 3). Returns the (n,) labels and the (k, 5) per-cluster sums of ``aug`` (so column 3
+    counts the points). Nearest = argmin_j (|c_j|^2 - 2 c_j . p): one (k, 4) x (4, n) product.
+    """
+    coef = np.empty((len(centers), 4))
+    coef[:, :3] = centers * -2.0
+    coef[:, 3] = (centers * centers).sum(axis=1)
+    labels = (coef @ aug_t).argmin(axis=0)
+    return labels, (labels == np.arange(len(centers))[:, None]).astype(np.float64) @ aug
 
 
 def segment(area_points_m: np.ndarray, k: int, *, random_state: int) -> Clusters:
-    """Seeded K-means (k-means++ init, Lloyd) of (n, 3) area points into at most ``k`` clusters.
-
-    Fewer than ``k`` come back only when the area has fewer distinct points than ``k``.
+    """Seeded K-means of (n, 3) area points into at most ``k`` clusters: greedy k-means++
+    (:func:`_kmeans_plusplus`), then Lloyd iterations until the centres move less than ``KMEANS_TOL`` x
+    the mean per-axis variance (scikit-learn's rule); the labels are the final centres' and the centres
+    those labels' means. An empty cluster keeps its centre during the iterations; clusters still empty at
+    the end (only possible with fewer distinct points than ``k``) are dropped and the rest renumbered.
     """
     pts = np.asarray(area_points_m, dtype=np.float64)
+    aug = np.empty((len(pts), 5))
+    aug[:, :3] = pts
+    aug[:, 3] = 1.0
+    aug[:, 4] = (pts * pts).sum(axis=1)
+    aug_t = aug[:, :4].T.copy()
     if k == 1:
-        labels = np.zeros(len(pts), dtype=np.int64)
-        centers = pts.mean(axis=0, keepdims=True)
+        labels, sums = np.zeros(len(pts), dtype=np.int64), aug.sum(axis=0, keepdims=True)
     else:
-        labels, centers = _lloyd(pts, k, random_state)
-        if np.bincount(labels, minlength=k).min() == 0:
-            # Drop clusters left empty (only possible with fewer distinct points than k) and renumber.
+        centers = _kmeans_plusplus(aug_t[:3], aug[:, 4], k, np.random.default_rng(random_state))
+        tol = KMEANS_TOL * float(np.var(aug_t[:3], axis=1).mean())
+        for _ in range(KMEANS_MAX_ITER):
+            _, sums = _cluster_sums(aug, aug_t, centers)
+            new = sums[:, :3] / np.maximum(sums[:, 3:4], 1.0)
+            if sums[:, 3].min() == 0:
+                new[sums[:, 3] == 0] = centers[sums[:, 3] == 0]
+            step = (new - centers).ravel()
+            centers = new
+            if step @ step <= tol:
+                break
+        labels, sums = _cluster_sums(aug, aug_t, centers)
+        if sums[:, 3].min() == 0:
             used, labels = np.unique(labels, return_inverse=True)
-            k = len(used)
-        centers = _means(np.hstack([pts, np.ones((len(pts), 1))]), labels, k)
-    sq = np.sum((pts - centers[labels]) ** 2, axis=1)
-    counts = np.bincount(labels, minlength=k)
-    radii = np.sqrt(np.bincount(labels, weights=sq, minlength=k) / np.maximum(counts, 1))
-    return Clusters(centers_m=centers, radii_m=radii, labels=labels)
+            sums = sums[used]
+    centers = sums[:, :3] / sums[:, 3:4]
+    # RMS distance from the centre: E|p|^2 - |c|^2 (float64; for clouds within a metre of the origin the
+    # cancellation costs < 1e-12 relative).
+    mean_sq = sums[:, 4] / sums[:, 3] - (centers * centers).sum(axis=1)
+    return Clusters(centers_m=centers, radii_m=np.sqrt(np.maximum(mean_sq, 0.0)), labels=labels)
