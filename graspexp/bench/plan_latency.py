@@ -113,7 +113,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 for c, fn in enumerate(row_calls):
                     timings[r, i, c] = time_runs(fn, args.runs)
     median = np.median(timings, axis=0)  # (row, call, 2)
-    p50, p95 = median[:, 0, 0], median[:, 0, 1]
+    p50 = median[:, 0, 0]
     print(
         f"{'object':<26}{'mode':<8}{'K':>3}{'area':>6}{'p50 ms':>9}{'p95 ms':>9}{'vs paper':>10}"
         f"{'K-means':>9}{'Eq.1-3':>8}"
