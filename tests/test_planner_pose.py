@@ -11,7 +11,7 @@ from graspexp.planning.pose import (
     grasp_pose,
     grasp_rotation,
     grasp_rotations,
-    opening_width_m,
+    opening_widths_m,
     slab_spans_m,
 )
 
@@ -66,13 +66,12 @@ def test_pose_origin_is_the_centre():
 
 
 def test_width_is_twice_the_radius_with_margin_clipped_to_the_stroke():
-    assert opening_width_m(0.02, 0.2, RG2) == pytest.approx(0.048)
-    assert opening_width_m(0.2, 0.2, RG2) == RG2.max_width_m
+    assert opening_widths_m(np.array([0.02]), 0.2, RG2)[0] == pytest.approx(0.048)
+    assert opening_widths_m(np.array([0.2]), 0.2, RG2)[0] == RG2.max_width_m
     tight = dataclasses.replace(RG2, min_width_m=0.01)
-    assert opening_width_m(0.001, 0.2, tight) == 0.01
-    for r in np.linspace(0.0, 0.3, 31):
-        w = opening_width_m(r, 0.2, tight)
-        assert tight.min_width_m <= w <= tight.max_width_m
+    assert opening_widths_m(np.array([0.001]), 0.2, tight)[0] == 0.01
+    w = opening_widths_m(np.linspace(0.0, 0.3, 31), 0.2, tight)
+    assert np.all((tight.min_width_m <= w) & (w <= tight.max_width_m))
 
 
 def test_slab_span_is_the_section_between_the_pads():

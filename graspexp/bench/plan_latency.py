@@ -9,7 +9,7 @@ Each object stands upright on the support as in :mod:`graspexp.plan` (N = ``plan
 and takes their p50 and p95; the table shows the median over repeats of each. BLAS/OpenMP run on one
 thread (``OMP_NUM_THREADS=1`` and friends set before numpy loads, and threadpoolctl). ``vs paper`` is
 p50 / 100 ms. Two more columns split the plan: ``K-means`` (:func:`graspexp.planning.clusters.segment`)
-and ``Eq.1-3`` (:func:`graspexp.planning.cost.cluster_costs` over every path above the support), each the
+and ``Eq.1-3`` (:func:`graspexp.planning.optimal.path_costs`, every path above the support), each the
 same median of per-repeat p50s. Without the YCB meshes under the data root it falls back to the procedural
 ``primitives`` dataset and says so. Extra ``key=value`` arguments are Hydra overrides.
 """
@@ -30,8 +30,7 @@ from threadpoolctl import threadpool_limits  # noqa: E402
 from graspexp.plan import CliError, compose, load, upright_request  # noqa: E402
 from graspexp.planning import PlanRequest, plan  # noqa: E402
 from graspexp.planning.clusters import segment  # noqa: E402
-from graspexp.planning.cost import cluster_costs  # noqa: E402
-from graspexp.planning.optimal import kmeans_random_state, paper_candidates  # noqa: E402
+from graspexp.planning.optimal import kmeans_random_state, paper_candidates, path_costs  # noqa: E402
 
 PAPER_PLAN_S = 0.1
 """The paper's planner time (clusters + paths + cost), seconds (IV-F, i7-9700)."""
@@ -56,17 +55,11 @@ def timed_calls(req: PlanRequest) -> list[Callable[[], object]]:
     cand = paper_candidates(req, "bench")
     area = cand.points[cand.area_mask]
     k, seed = len(cand.clusters.centers_m), kmeans_random_state(req.seed, req.planner.seed)
-    centers, radii = cand.clusters.centers_m, cand.clusters.radii_m
-
-    def costs() -> None:
-        for j in range(k):
-            ok = cand.feasible[j]
-            cluster_costs(
-                cand.points, centers[j], radii[j], cand.directions[j, ok], cand.axis, req.mode,
-                req.table_z, req.gripper.max_width_m, req.cost,
-            )  # fmt: skip
-
-    return [lambda: plan(req), lambda: segment(area, k, random_state=seed), costs]
+    return [
+        lambda: plan(req),
+        lambda: segment(area, k, random_state=seed),
+        lambda: path_costs(req, cand.points, cand.axis, cand.clusters, cand.directions, cand.feasible),
+    ]
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -36,11 +36,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from graspexp.geometry import make_pose
 from graspexp.planning.clusters import Clusters, choose_k, main_axis, segment
 from graspexp.planning.cost import cluster_costs
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.paths import above_support, approach_directions
-from graspexp.planning.pose import grasp_rotations, opening_widths_m, slab_spans_m
+from graspexp.planning.pose import grasp_rotation, grasp_rotations, opening_widths_m, slab_spans_m
 from graspexp.planning.request import PlanRequest, PlanResult
 from graspexp.seeding import derive_seed
 
@@ -96,7 +97,7 @@ def paper_candidates(req: PlanRequest, planner: str) -> Candidates:
     axis = main_axis(points if pl.main_axis == "object" else area)
     k = choose_k(pl.k, pl.k_max, area, axis, gr.max_width_m, pl.auto_k_stroke_fraction)
     clusters = segment(area, k, random_state=kmeans_random_state(req.seed, pl.seed))
-    centers, radii = clusters.centers_m, clusters.radii_m
+    centers = clusters.centers_m
     k, m = len(centers), int(pl.m)
 
     directions = approach_directions(centers, m)  # (K, M, 3)
@@ -106,22 +107,38 @@ def paper_candidates(req: PlanRequest, planner: str) -> Candidates:
             f"{planner}: every one of the {k * m} paths starts below the support plane z = "
             f"{req.table_z + pl.table_clearance_m:.4f} m (sphere radius {pl.sphere_radius_m} m)"
         )
-    costs = np.full((k, m), np.inf)
-    for j in range(k):
+    costs = path_costs(req, points, axis, clusters, directions, feasible)
+    return Candidates(points, mask, axis, clusters, directions, feasible, costs)
+
+
+def path_costs(
+    req: PlanRequest,
+    points: np.ndarray,
+    axis: np.ndarray,
+    clusters: Clusters,
+    directions: np.ndarray,
+    feasible: np.ndarray,
+) -> np.ndarray:
+    """(K, M) Eq. (1) or (2)-(3) of every path above the support, inf elsewhere (step 6).
+
+    points : (N, 3) world m; axis : (3,) main axis; directions : (K, M, 3); feasible : (K, M) bool.
+    """
+    costs = np.full(feasible.shape, np.inf)
+    for j, (center, radius) in enumerate(zip(clusters.centers_m, clusters.radii_m, strict=True)):
         ok = feasible[j]
         if ok.any():
             costs[j, ok] = cluster_costs(
                 points,
-                centers[j],
-                radii[j],
+                center,
+                radius,
                 directions[j, ok],
                 axis,
                 req.mode,
                 req.table_z,
-                gr.max_width_m,
+                req.gripper.max_width_m,
                 req.cost,
             )
-    return Candidates(points, mask, axis, clusters, directions, feasible, costs)
+    return costs
 
 
 def plan_optimal(req: PlanRequest) -> PlanResult:
@@ -177,7 +194,7 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
             )
         flat = int(np.argmin(np.where(fits, costs, np.inf)))
         best = (flat // m, flat % m)
-        best_rotation = grasp_rotations(directions[best][None], axis)[0]
+        best_rotation = grasp_rotation(directions[best], axis)
     else:
         fits = feasible & ~(section > openings[:, None])  # unexamined paths keep their table verdict
     n_too_wide = int((feasible & ~fits).sum())
@@ -186,9 +203,7 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
 
     kb, pb = best
     slab_extent = float(section[kb, pb])
-    pose = np.eye(4)
-    pose[:3, :3] = best_rotation
-    pose[:3, 3] = centers[kb]
+    pose = make_pose(best_rotation, centers[kb])
     shift_m = float(spans[kb, pb].mean())  # centre the symmetric pads on the section (pose.py doc)
     pose[:3, 3] += shift_m * pose[:3, 1]
     width = float(openings[kb])

@@ -74,11 +74,6 @@ def grasp_pose(center_m: np.ndarray, approach: np.ndarray, axis: np.ndarray) -> 
     return pose
 
 
-def opening_width_m(r_k_m: float, width_margin: float, gripper: GripperConfig) -> float:
-    """Planned opening between the pads, metres (module doc)."""
-    return float(opening_widths_m(np.array([r_k_m]), width_margin, gripper)[0])
-
-
 def opening_widths_m(radii_m: np.ndarray, width_margin: float, gripper: GripperConfig) -> np.ndarray:
     """(K,) planned openings, metres, for (K,) cluster radii ``r_k`` in metres (module doc)."""
     return np.clip(2.0 * np.asarray(radii_m) * (1.0 + width_margin), gripper.min_width_m, gripper.max_width_m)
