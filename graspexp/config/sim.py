@@ -33,9 +33,10 @@ class SimConfig:
     """Time given to the fingers to close, s."""
     retract_speed_mps: float = 0.25
     """Bin mode pull-back speed, m/s."""
-    slip_threshold_m: float = 0.02
-    """Slip = how far the grasp point (TCP) moved over the object, in the object frame, between closing
-    and the end of the hold; above this the grasp slipped, m."""
+    slip_threshold_m: float | None = None
+    """Optional stricter success criterion, m: fail as ``slipped`` when the grasp point (TCP) moved over
+    the object (object frame) by more than this between closing and the end of the hold. None (default):
+    the paper's criterion (IV-C), success = the object is still held; the slip is recorded either way."""
     max_speed_mps: float = 20.0
     """Any body faster than this (or NaN) means the simulation blew up, m/s."""
     log_rate_hz: float = 30.0
