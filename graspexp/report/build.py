@@ -21,7 +21,9 @@ from graspexp.report.render import display_frame, fmt_pct, footnotes, latex, mar
 from graspexp.report.tables import (
     SuccessTable,
     failure_breakdown,
+    STRICT_SLIP_M,
     runtime_table,
+    strict_table,
     success_tables,
     wide_numeric,
 )
@@ -33,6 +35,8 @@ class Report:
     tables: list[SuccessTable]
     failures: pd.DataFrame
     runtime: pd.DataFrame
+    strict: pd.DataFrame
+    """Success by the paper's criterion beside the stricter slip criterion, per setting."""
 
 
 def build_report(root: Path | str) -> Report:
@@ -40,8 +44,8 @@ def build_report(root: Path | str) -> Report:
     col = collect(root)
     df = col.results
     if df.empty:
-        return Report(col, [], pd.DataFrame(), pd.DataFrame())
-    return Report(col, success_tables(df), failure_breakdown(df), runtime_table(df))
+        return Report(col, [], pd.DataFrame(), pd.DataFrame(), pd.DataFrame())
+    return Report(col, success_tables(df), failure_breakdown(df), runtime_table(df), strict_table(df))
 
 
 def _runtime_display(rt: pd.DataFrame) -> pd.DataFrame:
@@ -106,6 +110,25 @@ def write_report(report: Report, out_dir: Path | str) -> str:
             "## Failure reasons per setting (trial counts)",
             "",
             markdown(report.failures, index=False),
+            "",
+        ]
+    if not report.strict.empty:
+        disp = report.strict.assign(
+            held_pct=[fmt_pct(v) for v in report.strict["held_pct"]],
+            strict_pct=[fmt_pct(v) for v in report.strict["strict_pct"]],
+        ).rename(
+            columns={"held_pct": "held (paper) %", "strict_pct": f"held, slip ≤ {STRICT_SLIP_M * 1e3:g} mm %"}
+        )
+        report.strict.to_csv(out / "strict.csv", index=False)
+        md += [
+            "## Success criterion: the paper's and a stricter one",
+            "",
+            markdown(disp, index=False),
+            "",
+            "Paper IV-C: success = the object is still held after the support is removed (collab) or after "
+            "the pull back (bin); the stricter column also needs the grasp point to have slid at most "
+            f"{STRICT_SLIP_M * 1e3:g} mm over the object (each log's slip_m; `sim.slip_threshold_m` makes it "
+            "the criterion of a run).",
             "",
         ]
     if not report.runtime.empty:
