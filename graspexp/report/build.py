@@ -6,6 +6,8 @@ Output files (in ``<dir>/report/`` unless told otherwise)::
     table<N>_<dataset>_<planner>.*   success table: .md / .tex (paper layout), .csv (numeric), .png
     failures.{md,csv,tex}            failure-reason counts per setting
     runtime.{md,csv,tex}             planner wall time p50 / p95 against the paper's 0.1 s
+    strict.csv                       success by the paper's criterion and by the stricter slip one
+    gallery.md, gallery/*.png        failure examples drawn from their logs (:mod:`.gallery`)
     unreadable.csv                   logs that could not be read (path, reason), if any
 """
 
@@ -16,12 +18,13 @@ import pandas as pd
 
 from graspexp.report.collect import Collected, collect
 from graspexp.report.figures import success_chart
+from graspexp.report.gallery import write_gallery
 from graspexp.report.paper import PLANNER_RUNTIME_S
 from graspexp.report.render import display_frame, fmt_pct, footnotes, latex, markdown
 from graspexp.report.tables import (
+    STRICT_SLIP_M,
     SuccessTable,
     failure_breakdown,
-    STRICT_SLIP_M,
     runtime_table,
     strict_table,
     success_tables,
@@ -79,8 +82,11 @@ def _unreadable_section(col: Collected) -> list[str]:
     return [*lines, ""]
 
 
-def write_report(report: Report, out_dir: Path | str) -> str:
-    """Write every file of the report into ``out_dir``; returns the Markdown of report.md."""
+def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 2) -> str:
+    """Write every file of the report into ``out_dir``; returns the Markdown of report.md.
+
+    gallery_per_reason : example failures drawn per setting and failure reason (0: no gallery).
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     col = report.collected
@@ -143,6 +149,15 @@ def write_report(report: Report, out_dir: Path | str) -> str:
             "",
             f"Wall time of the planning phase per trial (TrialResult timings_s.plan) on this machine; the "
             f"paper (section IV-F) reports {PLANNER_RUNTIME_S:g} s for the grasping strategy on an i7-9700.",
+            "",
+        ]
+    if gallery_per_reason > 0 and not col.results.empty:
+        write_gallery(col.results, out, gallery_per_reason)
+        md += [
+            "## Failure gallery",
+            "",
+            f"[gallery.md](gallery.md): up to {gallery_per_reason} failed trials per setting and failure "
+            "reason, drawn from their logs at the close and at the end (`gallery/*.png`).",
             "",
         ]
     md += _unreadable_section(col)

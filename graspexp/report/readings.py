@@ -57,7 +57,7 @@ def readings_frame(entries: dict[str, tuple[Path, str]]) -> tuple[pd.DataFrame, 
         for dataset in dict.fromkeys(df["dataset"]):
             table = success_table(df, dataset, planner)
             cells = table.cells
-            for _, r in cells[cells["label"] == AVERAGE].iterrows():
+            for _, r in cells[(cells["label"] == AVERAGE) & (cells["n"] > 0)].iterrows():
                 same = cells[
                     (cells["label"] == AVERAGE_SAME)
                     & (cells["mode"] == r["mode"])
