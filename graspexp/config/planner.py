@@ -9,6 +9,8 @@ from typing import Any
 
 from omegaconf import MISSING
 
+from graspexp.config.constraints import BOOL, TEXT, Interval, Options
+
 
 @dataclass
 class PlannerConfig:
@@ -113,3 +115,46 @@ class CostConfig:
     """0.05 in (beta_p - pi/2)^2 / 2 + 0.05."""
     table_far: float = 1.0
     """T when d_k > g."""
+
+
+PLANNER_CONSTRAINTS = {
+    "name": TEXT,
+    "k": [Options(("auto",)), Interval(1, 64, integer=True)],
+    "k_max": [Interval(1, 64, integer=True)],
+    "m": [Interval(1, 100_000, integer=True)],
+    "sphere_radius_m": [Interval(0, 2, "right", "m")],
+    "n_points": [Interval(16, 10_000_000, integer=True)],
+    "width_margin": [Interval(0, 10)],
+    "table_clearance_m": [Interval(-1, 1, unit="m")],
+    "seed": [Interval(0, None, integer=True)],
+    "main_axis": [Options(("object", "area"))],
+    "pose_axis": [Options(("object", "area"))],
+    "cluster_radius": [Options(("max", "rms"))],
+    "grasp_point": [Options(("centre", "section_middle"))],
+    "section_fit": BOOL,
+    "auto_k_stroke_fraction": [Interval(0, 10, "right")],
+    "n_candidates": [Interval(1, 1_000_000, integer=True)],
+    "n_approach": [Interval(1, 3600, integer=True)],
+    "friction_coef": [Interval(0, 10)],
+    "sample_area_only": BOOL,
+    "approach_tilt_weight": [Interval(0, 100)],
+    "collision_margin_m": [Interval(0, 0.1, unit="m")],
+    "width_clearance_m": [Interval(0, 0.1, unit="m")],
+    "com_weight": [Interval(0, 100)],
+}
+"""Allowed values of every ``planner`` key (see :mod:`graspexp.config.constraints`)."""
+
+COST_CONSTRAINTS = {
+    "angle_weight": [Interval(0, None, unit="per degree")],
+    "angle_target_deg": [Interval(0, 90, unit="deg")],
+    "angle_offset": [Interval(0, None)],
+    "angle_divisor": [Interval(0, None, "neither")],
+    "distance_numerator_mm2": [Interval(0, None, unit="mm^2")],
+    "distance_offset_mm2": [Interval(0, None, "neither", "mm^2")],
+    "distance_cap": [Interval(0, None)],
+    "table_beta_target_rad": [Interval(0, 1.5707963267948966, unit="rad")],
+    "table_beta_divisor": [Interval(0, None, "neither")],
+    "table_offset": [Interval(0, None)],
+    "table_far": [Interval(0, None)],
+}
+"""Allowed values of every ``cost`` key (see :mod:`graspexp.config.constraints`)."""
