@@ -15,15 +15,17 @@ Eq. (3):  T = (beta_p - pi/2)^2 / b + t0   if d_k <= g,   else t_far
 
 with every constant taken from :class:`graspexp.config.CostConfig`.
 
-``Y_ip`` uses ``Y^2 = |x - c|^2 - ((x - c) . d)^2`` (``d`` unit), one matrix product per cluster. The
-per-element work runs in float32 on coordinates relative to the centre (mm): the squared-distance
-cancellation then loses at most ~1e-3 mm^2, which changes a summand by far less than 1e-4; sums
-are float32 BLAS dot products (relative error ~1e-6). :func:`distance_term` with ``dtype=np.float64`` is the exact reference.
+``Y_ip`` uses ``Y^2 = |x - c|^2 - ((x - c) . d)^2`` (``d`` unit). The (paths x points) block is the
+planner's hot loop: a compiled float32 kernel (:func:`graspexp.planning.kernels.distance_sums`) evaluates
+it on coordinates relative to the centre (mm), where the squared-distance cancellation loses at most
+~1e-3 mm^2, which changes a summand by far less than 1e-4; its sums keep a relative error near 1e-6.
+:func:`distance_term` with ``dtype=np.float64`` is the exact numpy reference.
 """
 
 import numpy as np
 
 from graspexp.config import CostConfig
+from graspexp.planning.kernels import distance_sums
 
 M_TO_MM = 1000.0
 
@@ -70,30 +72,41 @@ def distance_term(
     rel_points_mm : (N, 3) object points minus the cluster centre, millimetres.
     directions : (M, 3) unit path directions (either sign: only the line matters).
     r_k_mm : the cluster radius, millimetres.
-    dtype : working precision of the (M, N) block (float32 fast path, float64 reference).
+    dtype : ``np.float32``: the compiled float32 kernel (the planner's path); ``np.float64``: the numpy
+        float64 reference (tests).
 
     Returns
     -------
     (M,) float64: ``sum_i min(cap, num / ((Y_ip - r_k)^2 + off))``.
     """
-    x = np.asarray(rel_points_mm, dtype=dtype)
-    d = np.asarray(directions, dtype=dtype)
-    n = len(x)
-    sq = np.einsum("ij,ij->i", x, x)  # (N,) |x - c|^2
-    block = d @ np.ascontiguousarray(x.T)  # (M, N) (x - c) . d
-    np.square(block, out=block)
-    np.subtract(sq, block, out=block)  # Y^2; only rounding can make it negative, abs() absorbs that
-    np.abs(block, out=block)
-    np.sqrt(block, out=block)  # Y_ip, mm
-    block -= dtype(r_k_mm)
-    np.square(block, out=block)
-    block += dtype(cost.distance_offset_mm2)
-    np.divide(dtype(cost.distance_numerator_mm2), block, out=block)
-    # Row operands, not scalars: numpy's scalar-broadcast minimum is several times slower here, and the
-    # BLAS product with a ones vector sums 3x faster than ``block.sum(axis=1)`` (its SIMD partial sums
-    # keep the float32 relative error near 1e-6).
-    np.minimum(block, np.full(n, cost.distance_cap, dtype=dtype), out=block)
-    return (block @ np.ones(n, dtype=dtype)).astype(np.float64)
+    if not cost.distance_offset_mm2 > 0:  # also rejects NaN
+        raise ValueError(
+            f"cost.distance_offset_mm2={cost.distance_offset_mm2!r} is invalid: expected a positive number "
+            "(it keeps Eq. (1)'s denominator away from 0)"
+        )
+    if dtype is np.float32:
+        x = np.ascontiguousarray(rel_points_mm, dtype=np.float64)
+        d = np.ascontiguousarray(directions, dtype=np.float64)
+        # The kernel is compiled with fastmath, which assumes finite numbers: a NaN or inf anywhere
+        # makes these sums non-finite.
+        if not np.isfinite(x.sum() + d.sum() + r_k_mm + cost.distance_numerator_mm2 + cost.distance_cap):
+            raise ValueError(
+                "Eq. (1) got a non-finite point, direction, radius or cost constant: check the cloud and "
+                "cost.distance_numerator_mm2 / cost.distance_cap"
+            )
+        return distance_sums(
+            x, d, r_k_mm, cost.distance_numerator_mm2, cost.distance_offset_mm2, cost.distance_cap
+        )
+    if dtype is not np.float64:
+        raise ValueError(
+            f"dtype={dtype!r} is invalid: expected np.float32 (compiled) or np.float64 (reference)"
+        )
+    x = np.asarray(rel_points_mm, dtype=np.float64)
+    d = np.asarray(directions, dtype=np.float64)
+    y2 = np.einsum("ij,ij->i", x, x) - (d @ x.T) ** 2  # (M, N) Y^2
+    y = np.sqrt(np.abs(y2))  # only rounding can make Y^2 negative
+    terms = cost.distance_numerator_mm2 / ((y - r_k_mm) ** 2 + cost.distance_offset_mm2)
+    return np.minimum(terms, cost.distance_cap).sum(axis=1)
 
 
 def cluster_costs(
