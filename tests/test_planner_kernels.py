@@ -18,7 +18,7 @@ from graspexp.datasets.catalog import candidate_paths
 from graspexp.plan import upright_pose
 from graspexp.planning import PlanRequest, plan
 from graspexp.planning.clusters import KMEANS_MAX_ITER, KMEANS_TOL, Clusters, segment
-from graspexp.planning.cost import cluster_costs, distance_term
+from graspexp.planning.cost import all_path_costs, distance_term
 from graspexp.planning.pose import grasp_rotations, slab_spans_m
 
 COST = CostConfig()
@@ -86,7 +86,7 @@ def reference_plan(req: PlanRequest, monkeypatch: pytest.MonkeyPatch):
     """The same plan with every compiled step replaced by its float64 numpy twin."""
     with monkeypatch.context() as patch:
         patch.setattr(optimal, "segment", segment_reference)
-        patch.setattr(optimal, "cluster_costs", functools.partial(cluster_costs, dtype=np.float64))
+        patch.setattr(optimal, "all_path_costs", functools.partial(all_path_costs, dtype=np.float64))
         patch.setattr(optimal, "slab_spans_m", slab_spans_reference)
         return plan(req)
 

@@ -48,48 +48,82 @@ _jit_fast = numba.njit(cache=_CACHE, nogil=True, error_model="numpy", boundschec
 
 @_jit_fast
 def distance_sums(
-    rel_points_mm: np.ndarray,
+    points: np.ndarray,
+    centers: np.ndarray,
+    scale: float,
+    radii_mm: np.ndarray,
     directions: np.ndarray,
-    r_k_mm: float,
+    feasible: np.ndarray,
     numerator_mm2: float,
     offset_mm2: float,
     cap: float,
 ) -> np.ndarray:
-    """``sum_i min(cap, num / ((Y_ip - r_k)^2 + off))`` for every path, in float32 (see :mod:`.cost`).
+    """``sum_i min(cap, num / ((Y_ip - r_k)^2 + off))`` for every feasible path of every cluster, float32
+    arithmetic (see :mod:`.cost`).
 
-    rel_points_mm : (N, 3) float64 points minus the cluster centre, mm; directions : (M, 3) float64 unit.
-    Returns (M,) float64. Requires finite inputs and ``offset_mm2 > 0`` (fastmath assumes no inf/NaN).
-    The points are copied once into float32 structure-of-arrays form (x, y, z, |x|^2) so that the inner
-    loop over points vectorises.
+    points : (N, 3) float64 and centers : (K, 3) float64 in one unit, ``scale`` x which gives mm;
+    radii_mm : (K,) r_k, mm; directions : (K, M, 3) float64 unit; feasible : (K, M) bool.
+    Returns (K, M) float64, 0 where not feasible. Requires finite inputs and ``offset_mm2 > 0``
+    (fastmath assumes no inf/NaN). Per cluster the points are copied once, relative to its centre, into
+    float32 structure-of-arrays form (x, y, z, |x|^2) so that the inner loop over points vectorises.
     """
-    n = rel_points_mm.shape[0]
+    n = points.shape[0]
+    n_clusters, n_paths = feasible.shape
     xs = np.empty(n, np.float32)
     ys = np.empty(n, np.float32)
     zs = np.empty(n, np.float32)
     sq = np.empty(n, np.float32)
-    for i in range(n):
-        a = np.float32(rel_points_mm[i, 0])
-        b = np.float32(rel_points_mm[i, 1])
-        c = np.float32(rel_points_mm[i, 2])
-        xs[i] = a
-        ys[i] = b
-        zs[i] = c
-        sq[i] = a * a + b * b + c * c
-    r = np.float32(r_k_mm)
     num = np.float32(numerator_mm2)
     off = np.float32(offset_mm2)
     top = np.float32(cap)
-    out = np.empty(directions.shape[0], np.float64)
-    for p in range(directions.shape[0]):
-        dx = np.float32(directions[p, 0])
-        dy = np.float32(directions[p, 1])
-        dz = np.float32(directions[p, 2])
-        total = np.float32(0.0)
+    out = np.zeros((n_clusters, n_paths))
+    for k in range(n_clusters):
         for i in range(n):
-            t = xs[i] * dx + ys[i] * dy + zs[i] * dz
-            u = np.sqrt(np.abs(sq[i] - t * t)) - r  # Y_ip - r_k; abs() absorbs rounding below 0
-            total += min(top, num / (u * u + off))
-        out[p] = total
+            a = np.float32((points[i, 0] - centers[k, 0]) * scale)
+            b = np.float32((points[i, 1] - centers[k, 1]) * scale)
+            c = np.float32((points[i, 2] - centers[k, 2]) * scale)
+            xs[i] = a
+            ys[i] = b
+            zs[i] = c
+            sq[i] = a * a + b * b + c * c
+        r = np.float32(radii_mm[k])
+        for p in range(n_paths):
+            if not feasible[k, p]:
+                continue
+            dx = np.float32(directions[k, p, 0])
+            dy = np.float32(directions[k, p, 1])
+            dz = np.float32(directions[k, p, 2])
+            total = np.float32(0.0)
+            for i in range(n):
+                t = xs[i] * dx + ys[i] * dy + zs[i] * dz
+                u = np.sqrt(np.abs(sq[i] - t * t)) - r  # Y_ip - r_k; abs() absorbs rounding below 0
+                total += min(top, num / (u * u + off))
+            out[k, p] = total
+    return out
+
+
+@_jit
+def grasp_frames(approaches: np.ndarray, axis: np.ndarray, parallel_tol: float) -> np.ndarray:
+    """(B, 3, 3) grasp rotations, columns X, Y, Z (:func:`graspexp.planning.pose.grasp_rotations`).
+
+    approaches : (B, 3) float64, any length; axis : (3,) float64 unit main axis.
+    """
+    out = np.empty((approaches.shape[0], 3, 3))
+    for b in range(approaches.shape[0]):
+        z = approaches[b] / np.sqrt(approaches[b, 0] ** 2 + approaches[b, 1] ** 2 + approaches[b, 2] ** 2)
+        x = axis - (z[0] * axis[0] + z[1] * axis[1] + z[2] * axis[2]) * z
+        norm = np.sqrt(x[0] ** 2 + x[1] ** 2 + x[2] ** 2)
+        if norm < parallel_tol:  # seed with the world axis least aligned with Z (lowest index on ties)
+            seed = np.zeros(3)
+            seed[np.argmin(np.abs(z))] = 1.0
+            x = seed - (seed[0] * z[0] + seed[1] * z[1] + seed[2] * z[2]) * z
+            norm = np.sqrt(x[0] ** 2 + x[1] ** 2 + x[2] ** 2)
+        x = x / norm
+        y = np.array([z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]])
+        y = y / np.sqrt(y[0] ** 2 + y[1] ** 2 + y[2] ** 2)
+        out[b, :, 0] = x
+        out[b, :, 1] = y
+        out[b, :, 2] = z
     return out
 
 
@@ -164,17 +198,17 @@ def _assign(
     xs: np.ndarray, ys: np.ndarray, zs: np.ndarray, centers: np.ndarray, labels: np.ndarray, sums: np.ndarray
 ) -> None:
     """Label every point with its nearest centre (lowest index on ties) and fill the (k, 5) per-cluster
-    sums of ``[x, y, z, 1, |p|^2]``: one labelling pass, then one branch-free pass per cluster."""
+    sums of ``[x, y, z, 1, |p|^2]``: one branch-free pass over the points per cluster to label, one to sum."""
     k = centers.shape[0]
-    for i in range(xs.shape[0]):
-        x, y, z = xs[i], ys[i], zs[i]
-        label = 0
-        nearest = (x - centers[0, 0]) ** 2 + (y - centers[0, 1]) ** 2 + (z - centers[0, 2]) ** 2
-        for j in range(1, k):
-            d = (x - centers[j, 0]) ** 2 + (y - centers[j, 1]) ** 2 + (z - centers[j, 2]) ** 2
-            if d < nearest:
-                nearest, label = d, j
-        labels[i] = label
+    nearest = _sq_dists(xs, ys, zs, centers[0, 0], centers[0, 1], centers[0, 2])
+    labels[:] = 0
+    for j in range(1, k):  # branch-free and vectorised over the points: labels are spatially mixed
+        cx, cy, cz = centers[j, 0], centers[j, 1], centers[j, 2]
+        for i in range(xs.shape[0]):
+            d = (xs[i] - cx) ** 2 + (ys[i] - cy) ** 2 + (zs[i] - cz) ** 2
+            closer = d < nearest[i]
+            nearest[i] = d if closer else nearest[i]
+            labels[i] = j if closer else labels[i]
     for j in range(k):
         sx = sy = sz = count = sq = 0.0
         for i in range(xs.shape[0]):
