@@ -237,25 +237,28 @@ def slab_spans(
     columns. Returns (B, 2) float64 relative to each origin, [0, 0] where no point qualifies
     (:func:`graspexp.planning.pose.slab_spans_m`). Requires finite inputs (fastmath).
     """
-    n_frames = rotations.shape[0]
-    out = np.zeros((n_frames, 2))
+    xs = np.ascontiguousarray(points[:, 0])  # structure of arrays: contiguous loads
+    ys = np.ascontiguousarray(points[:, 1])
+    zs = np.ascontiguousarray(points[:, 2])
+    out = np.zeros((rotations.shape[0], 2))
     big = 1e30  # a finite sentinel: fastmath assumes no inf
-    for b in range(n_frames):
+    for b in range(rotations.shape[0]):
         r = rotations[b]
         cx, cy, cz = centers[b, 0], centers[b, 1], centers[b, 2]
-        lo, hi, count = big, -big, 0
-        for i in range(points.shape[0]):
-            px = points[i, 0] - cx
-            py = points[i, 1] - cy
-            pz = points[i, 2] - cz
+        lo, hi = big, -big
+        for i in range(xs.shape[0]):
+            px, py, pz = xs[i] - cx, ys[i] - cy, zs[i] - cz
             x = r[0, 0] * px + r[1, 0] * py + r[2, 0] * pz
             y = r[0, 1] * px + r[1, 1] * py + r[2, 1] * pz
             z = r[0, 2] * px + r[1, 2] * py + r[2, 2] * pz
-            inside = abs(x) <= half_width and z >= z_lo and z <= z_hi
-            lo = min(lo, y if inside else big)
-            hi = max(hi, y if inside else -big)
-            count += inside
-        if count:
+            # Selects, not branches (no short circuit). LLVM does not vectorise these float min/max
+            # reductions (it wants function-wide no-NaN attributes numba does not set): ~3 ns a point.
+            inside = (abs(x) <= half_width) & (z >= z_lo) & (z <= z_hi)
+            y_lo = y if inside else big
+            y_hi = y if inside else -big
+            lo = y_lo if y_lo < lo else lo
+            hi = y_hi if y_hi > hi else hi
+        if lo <= hi:  # some point was inside
             out[b, 0] = lo
             out[b, 1] = hi
     return out
