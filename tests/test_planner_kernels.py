@@ -143,9 +143,11 @@ def test_kernel_cache_goes_to_the_graspexp_cache_and_survives_an_unwritable_one(
     """A subprocess per case: numba's cache folder is fixed when the kernels module is imported."""
     script = (
         "import numba, numpy as np\n"
+        "from graspexp.config import CostConfig\n"
         "from graspexp.planning import kernels\n"
+        "from graspexp.planning.cost import distance_term\n"
         "print(kernels._CACHE, numba.config.CACHE_DIR)\n"
-        "print(kernels.distance_sums(np.ones((5, 3)), np.eye(3), 1.0, 20.0, 1.0, 1.0).sum())\n"
+        "print(distance_term(np.ones((5, 3)), np.eye(3), 1.0, CostConfig()).sum())\n"
     )
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     blocker = tmp_path / "a_file"
