@@ -6,16 +6,15 @@ Main axis
     positive (ties: the first such component), which makes it a deterministic function of the cloud.
 
 K (``planner.k: auto``)
-    ``K = clamp(ceil(L / (AUTO_K_STROKE_FRACTION * g)), 1, k_max)``, where ``L`` is the extent of the
-    area along its main axis (max - min of the projections, m) and ``g = gripper.max_width_m``. With the
-    fraction 0.5 each cluster spans at most half the stroke along the main axis, so its along-axis
-    spread never alone pushes the opening ``2 r_k (1 + margin)`` past the stroke; a bigger gripper gives
-    fewer clusters, as the paper asks (III-B, IV-D). K never exceeds the number of area points.
+    ``K = clamp(ceil(L / (c * g)), 1, k_max)``, where ``L`` is the extent of the area along its main axis
+    (max - min of the projections, m), ``g = gripper.max_width_m`` and ``c =
+    planner.auto_k_stroke_fraction`` (its docstring gives the reading); a bigger gripper gives fewer
+    clusters, as the paper asks (III-B, IV-D). K never exceeds the number of area points.
 
-Radius ``r_k``
-    The root-mean-square distance of the cluster's points from its centre ``c_k`` (m). The centre is
-    the cluster mean (the K-means centroid), so ``r_k^2`` is the cluster's total variance. RMS rather
-    than max keeps a few outlying surface points from inflating the opening.
+Radius ``r_k`` (``planner.cluster_radius``)
+    ``rms``: the root-mean-square distance of the cluster's points from its centre ``c_k`` (the centre
+    is the cluster mean, so ``r_k^2`` is the cluster's total variance); ``max``: the largest distance
+    (:func:`max_radii_m`). Metres.
 """
 
 import math
@@ -24,10 +23,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from graspexp.planning.kernels import kmeans
-
-AUTO_K_STROKE_FRACTION = 0.5
-"""Default ``c`` in the ``k: auto`` rule (``planner.auto_k_stroke_fraction``): one cluster per
-``c * gripper.max_width_m`` of area length."""
 
 KMEANS_MAX_ITER = 100
 """Lloyd iterations cap."""
@@ -68,7 +63,7 @@ def choose_k(
     area_points_m: np.ndarray,
     axis: np.ndarray,
     gripper_max_width_m: float,
-    stroke_fraction: float = AUTO_K_STROKE_FRACTION,
+    stroke_fraction: float,
 ) -> int:
     """Number of clusters: ``k`` if an int, else the ``auto`` rule of the module doc; at most n_area."""
     n_area = len(area_points_m)
@@ -88,7 +83,8 @@ class Clusters:
     """K-means result on the grasping area.
 
     centers_m : (K, 3) float64 centroids, world, metres.
-    radii_m : (K,) float64 RMS distance of each cluster's points from its centre, metres.
+    radii_m : (K,) float64 RMS distance of each cluster's points from its centre, metres (the planner
+        may replace it by :func:`max_radii_m`, ``planner.cluster_radius``).
     labels : (n_area,) int cluster index of each area point.
     """
 
@@ -123,3 +119,12 @@ def segment(area_points_m: np.ndarray, k: int, *, random_state: int) -> Clusters
     # cancellation costs < 1e-12 relative).
     mean_sq = sums[:, 4] / sums[:, 3] - (centers * centers).sum(axis=1)
     return Clusters(centers_m=centers, radii_m=np.sqrt(np.maximum(mean_sq, 0.0)), labels=labels)
+
+
+def max_radii_m(area_points_m: np.ndarray, clusters: Clusters) -> np.ndarray:
+    """(K,) largest distance of each cluster's (n, 3) area points from its centre, metres."""
+    pts = np.asarray(area_points_m, dtype=np.float64)
+    d2 = ((pts - clusters.centers_m[clusters.labels]) ** 2).sum(axis=1)
+    out = np.zeros(len(clusters.centers_m))
+    np.maximum.at(out, clusters.labels, d2)
+    return np.sqrt(out)
