@@ -17,7 +17,7 @@ from graspexp.datasets import load_object
 from graspexp.datasets.catalog import candidate_paths
 from graspexp.plan import upright_pose
 from graspexp.planning import PlanRequest, plan
-from graspexp.planning.clusters import KMEANS_MAX_ITER, KMEANS_TOL, Clusters, segment
+from graspexp.planning.clusters import KMEANS_MAX_ITER, KMEANS_TOL, Clusters, max_radii_m, segment
 from graspexp.planning.cost import all_path_costs, distance_term
 from graspexp.planning.pose import grasp_rotations, slab_spans_m
 
@@ -136,6 +136,9 @@ def test_kmeans_kernel_matches_the_numpy_twin_on_blobs():
         np.testing.assert_array_equal(got.labels, ref.labels)
         np.testing.assert_allclose(got.centers_m, ref.centers_m, atol=1e-14)
         np.testing.assert_allclose(got.radii_m, ref.radii_m, rtol=1e-9)
+        far = np.zeros(len(ref.centers_m))  # max_radii_m in numpy
+        np.maximum.at(far, ref.labels, ((blobs - ref.centers_m[ref.labels]) ** 2).sum(axis=1))
+        np.testing.assert_array_equal(max_radii_m(blobs, ref), np.sqrt(far))
 
 
 @pytest.mark.slow

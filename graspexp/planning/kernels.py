@@ -187,6 +187,20 @@ def kmeans(
     return labels, sums
 
 
+@_jit
+def cluster_max_distances(points: np.ndarray, centers: np.ndarray, labels: np.ndarray) -> np.ndarray:
+    """(K,) largest distance of the (n, 3) points from their cluster's centre (``labels`` (n,) int64 index
+    the (K, 3) centres); 0 for a cluster without points."""
+    out = np.zeros(centers.shape[0])
+    for i in range(points.shape[0]):
+        j = labels[i]
+        d2 = (points[i, 0] - centers[j, 0]) ** 2 + (points[i, 1] - centers[j, 1]) ** 2
+        d2 += (points[i, 2] - centers[j, 2]) ** 2
+        if d2 > out[j]:
+            out[j] = d2
+    return np.sqrt(out)
+
+
 @_jit_fast
 def _sq_dists(xs: np.ndarray, ys: np.ndarray, zs: np.ndarray, cx: float, cy: float, cz: float) -> np.ndarray:
     """(n,) squared distances of the points (coordinate arrays) from the point (cx, cy, cz)."""
