@@ -1,14 +1,17 @@
-"""Compiled (numba) loops of the planner: Eq. (1)'s distance sums, K-means and the section between the pads.
+"""Compiled (numba) loops of the planner: Eq. (1)'s distance sums, K-means, grasp frames, the section between
+the pads.
 
 Each kernel is a plain serial loop (no threads: on a shared 2-core machine ``prange`` was 20x slower) that
 numba compiles on first use and caches on disk, so a process pays the compilation once per machine and
-afterwards only numba's import and the cache load (README, "Benchmarks"). The cache lives in
+afterwards only numba's import and the cache load (README, "Development"). The cache lives in
 ``$NUMBA_CACHE_DIR`` when set, else in ``numba/`` under the graspexp cache folder (``$GRASPEXP_CACHE``, else
 ``~/.cache/graspexp``), never beside the installed package, which may be read-only. When no writable folder
 is found the kernels still work, compiled afresh in every process.
 
-The public wrappers live with their numpy meaning: :func:`graspexp.planning.cost.distance_term`,
-:func:`graspexp.planning.clusters.segment`, :func:`graspexp.planning.pose.slab_spans_m`.
+The public wrappers live with their meaning: :func:`graspexp.planning.cost.all_path_costs` and
+:func:`~graspexp.planning.cost.distance_term`, :func:`graspexp.planning.clusters.segment` and
+:func:`~graspexp.planning.clusters.max_radii_m`, :func:`graspexp.planning.pose.grasp_rotations` and
+:func:`~graspexp.planning.pose.slab_spans_m`.
 """
 
 import os
