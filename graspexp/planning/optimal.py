@@ -45,7 +45,7 @@ import numpy as np
 from graspexp.config import GripperConfig
 from graspexp.geometry import make_pose
 from graspexp.planning.clusters import Clusters, choose_k, main_axis, max_radii_m, segment
-from graspexp.planning.cost import cluster_costs
+from graspexp.planning.cost import all_path_costs
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.paths import above_support, approach_directions
 from graspexp.planning.pose import grasp_rotation, grasp_rotations, opening_widths_m, slab_spans_m
@@ -140,22 +140,18 @@ def path_costs(
 
     points : (N, 3) world m; axis : (3,) main axis; directions : (K, M, 3); feasible : (K, M) bool.
     """
-    costs = np.full(feasible.shape, np.inf)
-    for j, (center, radius) in enumerate(zip(clusters.centers_m, clusters.radii_m, strict=True)):
-        ok = feasible[j]
-        if ok.any():
-            costs[j, ok] = cluster_costs(
-                points,
-                center,
-                radius,
-                directions[j, ok],
-                axis,
-                req.mode,
-                req.table_z,
-                req.gripper.max_width_m,
-                req.cost,
-            )
-    return costs
+    return all_path_costs(
+        points,
+        clusters.centers_m,
+        clusters.radii_m,
+        directions,
+        feasible,
+        axis,
+        req.mode,
+        req.table_z,
+        req.gripper.max_width_m,
+        req.cost,
+    )
 
 
 def plan_optimal(req: PlanRequest) -> PlanResult:
