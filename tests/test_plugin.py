@@ -94,3 +94,9 @@ def test_a_broken_or_unknown_plugin_is_one_line_naming_it(tmp_path):
     assert unknown.returncode == 2 and unknown.stderr.startswith(
         "graspexp: error: planner.name='nope' is unknown"
     )
+
+
+def test_importing_the_planners_loads_neither_hydra_nor_sapien():
+    code = "import sys, graspexp.planning; print(sorted({m.split('.')[0] for m in sys.modules} & {'hydra', 'sapien'}))"
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0 and proc.stdout.strip() == "[]", proc.stderr
