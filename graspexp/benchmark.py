@@ -42,6 +42,7 @@ from graspexp.compare.report import success_table as noise_success_table
 from graspexp.config import ConfigError, PluginError, validate
 from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
 from graspexp.report.collect import collect
+from graspexp.report.contact_area import finger_contacts_in_area
 from graspexp.report.paper import PAPER_TABLES, SETTINGS, TRIALS_PER_SETTING
 from graspexp.report.render import display_frame, footnotes, markdown
 from graspexp.report.stats import percentiles, wilson_interval
@@ -50,8 +51,9 @@ from graspexp.report.tables import failure_breakdown, success_table
 NOISE_LEVELS: tuple[tuple[float, float], ...] = ((10.0, 0.0), (20.0, 0.0), (0.0, 10.0))
 """Pose-noise levels (translation std mm, rotation std degrees) run besides zero, as in ``nox -s compare``."""
 IN_AREA_NOTE = (
-    "In-area contact %: not computed yet (it needs the logs' /contacts against each object's grasping "
-    "area; the log format is being changed); n/a in the ranking."
+    "In-area contact %: share of the finger-object contacts at the end of closing whose nearest point of "
+    "the object's cloud is a grasping-area point (graspexp/report/contact_area.py; from each log's "
+    "/contacts and /tf), over the trials whose fingers touch the object then."
 )
 
 
@@ -184,13 +186,22 @@ def run_all(bench: Benchmark, todo: list[Job]) -> list[str]:
 
 
 def results(all_jobs: list[Job]) -> pd.DataFrame:
-    """One row per readable trial log of every job (report.collect columns plus trans_mm, rot_deg)."""
+    """One row per readable trial log of every job: report.collect columns plus trans_mm, rot_deg and the
+    finger-object contacts at the end of closing (``contacts``) and how many lie in the grasping area
+    (``contacts_in_area``)."""
     frames = []
     for job in all_jobs:
         if Path(job.run_dir).is_dir():
             df = collect(job.run_dir).results
             if not df.empty:
-                frames.append(df.assign(trans_mm=job.trans_mm, rot_deg=job.rot_deg))
+                counts = [finger_contacts_in_area(p) for p in df["path"]]
+                df = df.assign(
+                    trans_mm=job.trans_mm,
+                    rot_deg=job.rot_deg,
+                    contacts_in_area=[c[0] for c in counts],
+                    contacts=[c[1] for c in counts],
+                )
+                frames.append(df)
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
 
 
@@ -211,7 +222,8 @@ def ranking(df: pd.DataFrame, dataset: str, settings: list[str]) -> pd.DataFrame
             mode, rot = s.split("/")
             row[s] = _success(g[(g["mode"] == mode) & (g["rot"] == rot)])
         planned = g[g["reason"] != "no_feasible_grasp"]
-        row["in-area contact %"] = "n/a"
+        touched = int(g["contacts"].sum())
+        row["in-area contact %"] = f"{100 * g['contacts_in_area'].sum() / touched:.0f}" if touched else "n/a"
         row[f"force-closure % (mu<={FC_MU:g})"] = (
             f"{100 * (planned['fc_min_mu'] <= FC_MU + 1e-9).mean():.0f}" if len(planned) else "n/a"
         )

@@ -7,7 +7,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pandas as pd
 import pytest
+
+from graspexp.record import read_result
+from graspexp.report.contact_area import finger_contacts_in_area
 
 REPO = Path(__file__).resolve().parent.parent
 EXAMPLE = REPO / "examples" / "top_down_planner"
@@ -76,6 +80,12 @@ def test_example_plugin_runs_through_the_benchmark_beside_a_builtin_planner(tmp_
         p.name
         for p in (out / "top_down" / "runs" / "primitives" / "collab_z_t0_r0" / "trials" / "can").iterdir()
     ) == ["000.mcap"]
+    rank = pd.read_csv(out / "top_down" / "ranking.csv").set_index("planner")
+    for planner in ("top_down", "obb"):
+        log = out / planner / "runs" / "primitives" / "collab_z_t0_r0" / "trials" / "can" / "000.mcap"
+        inside, touching = finger_contacts_in_area(log)
+        if read_result(log)["success"]:  # held: both fingers touch the can at the end of closing
+            assert touching == 2 and rank.loc[planner, "in-area contact %"] == pytest.approx(50 * inside)
     again = _run(args, env, tmp_path)  # resumes: the trial log is read back, not re-run
     assert again.returncode == 0 and (out / "top_down" / "summary.md").read_text() == summary
 
