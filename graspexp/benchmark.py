@@ -248,9 +248,9 @@ def ranking(df: pd.DataFrame, dataset: str, settings: list[str]) -> pd.DataFrame
     return table
 
 
-def reproduce_record(bench: Benchmark, all_jobs: list[Job], argv: list[str]) -> dict:
-    """Everything needed to re-run the suite: command, benchmark keys, each job's composed config,
-    package versions, and each planner's package, entry point and version."""
+def reproduce_record(bench: Benchmark, all_jobs: list[Job], configs: list[dict], argv: list[str]) -> dict:
+    """Everything needed to re-run the suite: command, benchmark keys, each job's composed config
+    (``configs``, in job order), package versions, and each planner's package, entry point and version."""
     from graspexp.runner import package_versions
 
     planners = {}
@@ -266,14 +266,16 @@ def reproduce_record(bench: Benchmark, all_jobs: list[Job], argv: list[str]) -> 
             {
                 **{k: v for k, v in dataclasses.asdict(j).items() if k != "overrides"},
                 "overrides": list(j.overrides),
-                "config": OmegaConf.to_container(compose_config(list(j.overrides)), resolve=True),
+                "config": c,
             }
-            for j in all_jobs
+            for j, c in zip(all_jobs, configs, strict=True)
         ],
     }
 
 
-def write_summary(bench: Benchmark, all_jobs: list[Job], errors: list[str], argv: list[str]) -> str:
+def write_summary(
+    bench: Benchmark, all_jobs: list[Job], configs: list[dict], errors: list[str], argv: list[str]
+) -> str:
     """Write the result folder ``OUT/<planner>/`` (module doc); returns the Markdown summary."""
     out = Path(bench.out) / bench.planner
     out.mkdir(parents=True, exist_ok=True)
@@ -313,7 +315,9 @@ def write_summary(bench: Benchmark, all_jobs: list[Job], errors: list[str], argv
         lines += ["## Jobs that did not finish", "", *(f"- {e}" for e in errors), ""]
     text = "\n".join(lines) + "\n"
     (out / "summary.md").write_text(text)
-    (out / "reproduce.json").write_text(json.dumps(reproduce_record(bench, all_jobs, argv), indent=1))
+    (out / "reproduce.json").write_text(
+        json.dumps(reproduce_record(bench, all_jobs, configs, argv), indent=1)
+    )
     return text
 
 
@@ -326,14 +330,17 @@ def main(argv: list[str] | None = None) -> int:
         bench = parse_args(argv)
         get_plugin(bench.planner)
         all_jobs = jobs(bench)
+        configs = []
         for job in all_jobs:  # every job's config is checked before the first trial runs
-            validate(compose_config(list(job.overrides)))
+            cfg = compose_config(list(job.overrides))
+            validate(cfg)
+            configs.append(OmegaConf.to_container(cfg, resolve=True))
     except (ConfigError, PluginError) as exc:
         fail(str(exc))
     except Exception as exc:  # Hydra composition errors: one line, no traceback
         fail(str(exc).splitlines()[0])
     errors = run_all(bench, all_jobs)
-    print(write_summary(bench, all_jobs, errors, argv), end="")
+    print(write_summary(bench, all_jobs, configs, errors, argv), end="")
     print(f"graspexp.benchmark: results in {Path(bench.out) / bench.planner}", file=sys.stderr)
     for e in errors:
         print(f"graspexp.benchmark: job failed: {e}", file=sys.stderr)

@@ -56,10 +56,12 @@ class LoadedPlanner:
     entry_point: str
     """``module:attribute`` of the entry point."""
     plugin: PlannerPlugin
+    package_version: str = "unknown"
 
     @property
     def version(self) -> str:
-        return self.plugin.version or self.package.rsplit(" ", 1)[-1]
+        """The plugin's own version, else its package's."""
+        return self.plugin.version or self.package_version
 
 
 def _package(ep: EntryPoint) -> str:
@@ -105,7 +107,10 @@ def _load(ep: EntryPoint) -> LoadedPlanner:
         )
     if not (callable(plugin.plan) or (isinstance(plugin.plan, str) and ":" in plugin.plan)):
         raise PluginError(f"{where}: plan={plugin.plan!r} is neither a function nor 'module:function'")
-    return LoadedPlanner(ep.name, _package(ep), ep.value, plugin)
+    dist = getattr(ep, "dist", None)
+    return LoadedPlanner(
+        ep.name, _package(ep), ep.value, plugin, dist.version if dist is not None else "unknown"
+    )
 
 
 @functools.cache
