@@ -2,12 +2,14 @@
 
 from pathlib import Path
 
+from omegaconf import DictConfig, OmegaConf
+
 from graspexp.config.cost import CostConfig
 from graspexp.config.dataset import DatasetConfig
 from graspexp.config.gripper import GripperConfig
 from graspexp.config.job import JobConfig
 from graspexp.config.mode import ModeConfig
-from graspexp.config.plugins import LoadedPlanner, load_planners
+from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
 from graspexp.config.rot import RotConfig
 from graspexp.config.sim import SimConfig
 
@@ -56,3 +58,13 @@ def register_configs() -> None:
             cs.store(group="planner", name=f"base_{name}", node=schema)
             if name not in presets:
                 cs.store(group="planner", name=name, node=schema(name=name))
+
+
+def job_config_from_yaml(text: str) -> DictConfig:
+    """A job config recorded as YAML (e.g. a trial log's ``config_yaml``) typed again by its schemas, the
+    ``planner`` node by the schema of the planner it names (:class:`PluginError` if none is installed)."""
+    data = OmegaConf.create(text)
+    planner = OmegaConf.structured(get_plugin(data.planner.name).plugin.config)
+    cfg = OmegaConf.merge(OmegaConf.structured(JobConfig), data)
+    cfg.planner = OmegaConf.merge(planner, data.planner)
+    return cfg
