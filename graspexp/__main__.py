@@ -12,11 +12,12 @@ register_configs()
 @hydra.main(version_base="1.3", config_path="../conf", config_name="config")
 def _job(cfg: DictConfig) -> float:
     from graspexp.datasets import DatasetError
+    from graspexp.record.live import LiveViewError
     from graspexp.runner import run_job
 
     try:
         return run_job(cfg)
-    except DatasetError as exc:
+    except (DatasetError, LiveViewError) as exc:
         fail(str(exc))
 
 

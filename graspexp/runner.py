@@ -13,7 +13,6 @@ With ``record=false`` no log is written (faster, but nothing to replay and nothi
 import logging
 import platform
 import traceback
-from contextlib import nullcontext
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
@@ -24,11 +23,11 @@ from tqdm import tqdm
 
 from graspexp.config import validate
 from graspexp.datasets import DatasetError, available_objects, dataset_objects, load_object
-from graspexp.record import CorruptLogError, TrialRecorder, read_result
+from graspexp.record import CorruptLogError, object_scene, read_result, trial_recorder
 from graspexp.seeding import derive_seed
 from graspexp.sim.collision import convex_hulls
 from graspexp.sim.outcome import FailureReason, TrialResult
-from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial, scene_entities, trial_seed
+from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
 
 log = logging.getLogger(__name__)
 PACKAGES = ("graspexp", "sapien", "numpy", "scikit-learn", "trimesh", "coacd", "mcap", "hydra-core")
@@ -106,7 +105,7 @@ def run_object_trials(
     """Every trial of one object; finished trials found in ``run_dir`` are read back instead of re-run."""
     plain = plain_config(cfg)
     job_meta = job_metadata(cfg)
-    model = hulls = entities = load_error = None
+    model = hulls = scene = load_error = None
     results = []
     for i in range(cfg.trials):
         path = trial_log_path(run_dir, object_name, i)
@@ -114,10 +113,8 @@ def run_object_trials(
         result = _finished(path)
         if result is None:
             path.parent.mkdir(parents=True, exist_ok=True)
-            recorder = (
-                TrialRecorder(path, _metadata(job_meta, object_name, i, seed))
-                if cfg.record
-                else nullcontext(NullRecorder())
+            recorder = trial_recorder(
+                path if cfg.record else None, _metadata(job_meta, object_name, i, seed), plain
             )
             with recorder as rec:
                 try:
@@ -127,8 +124,8 @@ def run_object_trials(
                         cloud_seed = derive_seed(cfg.seed, "cloud", object_name)
                         model = load_object(cfg.dataset, object_name, cfg.planner.n_points, cloud_seed)
                         hulls = convex_hulls(model.mesh, plain.sim)
-                        entities = scene_entities(plain, hulls)
-                    result = run_trial(TrialContext(plain, model, hulls, i, seed, rec, entities))
+                        scene = object_scene(plain, hulls)
+                    result = run_trial(TrialContext(plain, model, hulls, i, seed, rec, scene))
                 except Exception as exc:  # one trial's error is recorded; the sweep goes on
                     if model is None:
                         load_error = exc

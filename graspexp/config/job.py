@@ -45,5 +45,9 @@ class JobConfig:
     """Subset of the dataset's objects; None: all of them."""
     record: bool = True
     """Write one MCAP log per trial."""
+    live: bool = False
+    """Stream the running trials to the Foxglove app over a WebSocket server on 127.0.0.1 (live view)."""
+    live_port: int = 8765
+    """Port of the live-view server (0: any free port)."""
     progress: bool = True
     """Show a progress bar."""
