@@ -1,6 +1,7 @@
 """MCAP trial logs: writer/reader round trip, determinism, atomic files, corruption, replay CLI."""
 
 import io
+import json
 import math
 import subprocess
 import sys
@@ -16,6 +17,7 @@ from mcap_protobuf.decoder import DecoderFactory
 from graspexp.geometry import axis_angle_matrix, matrix_to_quat_wxyz
 from graspexp.record import (
     CorruptLogError,
+    OldLogFormatError,
     TrialRecorder,
     TrialWriter,
     box_entity,
@@ -122,7 +124,7 @@ def write_typical_trial(writer: TrialWriter, n_faces: int = 500) -> None:
         contacts = [
             {
                 "body0": "object",
-                "body1": "table",
+                "body1": "support",
                 "position": (0, 0, 0),
                 "normal": (0, 0, 1),
                 "force_n": (0.0, 0.0, 2.0),
@@ -173,9 +175,9 @@ def test_round_trip_file(trial_file):
     assert log.metadata == METADATA
     assert log.topics == {
         "/scene": "foxglove.SceneUpdate",
-        "/tf": "foxglove.FrameTransform",
+        "/tf": "foxglove.FrameTransforms",
         "/grasp_pose": "foxglove.PoseInFrame",
-        "/contacts": "graspexp.Contacts@1",
+        "/contacts": "foxglove.PointCloud",
         "/grasp": "graspexp.PlannedGrasp@1",
         "/phase": "graspexp.Phase@1",
         "/result": "graspexp.TrialResult@2",
@@ -206,7 +208,7 @@ def test_round_trip_file(trial_file):
     assert g is not None and g["pose"].shape == (4, 4) and math.isnan(g["cost"])
     assert (g["K"], g["M"], g["n_feasible"], g["cluster"], g["path"]) == (8, 16, 11, 2, 5)
     np.testing.assert_allclose(g["approach"], [0, 0, -1])
-    assert log.message_count == 1 + 7 + 2 + n * 4 + n + 1
+    assert log.message_count == 1 + 7 + 2 + n + n + 1  # scene, phases, grasp + pose, tf, contacts, result
     assert len(log.scenes) == 1 and len(log.scenes[0][1]) == 3
 
 
@@ -243,7 +245,7 @@ def test_log_times_are_sim_time_ns(trial_file):
         reader = make_reader(f, decoder_factories=[DecoderFactory()])
         for _, _channel, message, body in reader.iter_decoded_messages(topics=["/tf"]):
             assert message.log_time == message.publish_time
-            assert body.timestamp.ToNanoseconds() == message.log_time
+            assert all(t.timestamp.ToNanoseconds() == message.log_time for t in body.transforms)
         summary = reader.get_summary()
     assert summary.statistics.message_end_time == 5_000_000_000
     assert summary.statistics.message_start_time == 0
@@ -266,16 +268,11 @@ def test_quaternion_order_converted(trial_file):
     np.testing.assert_allclose(q_wxyz, QUAT_Z90_WXYZ, atol=1e-12)
     with open(trial_file, "rb") as f:
         reader = make_reader(f, decoder_factories=[DecoderFactory()])
-        for _, _channel, _message, body in reader.iter_decoded_messages(topics=["/tf"]):
-            if body.child_frame_id == "object":
-                rot = body.rotation
-                np.testing.assert_allclose(
-                    [rot.x, rot.y, rot.z, rot.w], [0, 0, math.sqrt(0.5), math.sqrt(0.5)]
-                )
-                assert body.parent_frame_id == "world"
-                break
-        else:
-            pytest.fail("no /tf message for the object frame")
+        _, _, _, body = next(reader.iter_decoded_messages(topics=["/tf"]))
+    (tf,) = [t for t in body.transforms if t.child_frame_id == "object"]
+    rot = tf.rotation
+    np.testing.assert_allclose([rot.x, rot.y, rot.z, rot.w], [0, 0, math.sqrt(0.5), math.sqrt(0.5)])
+    assert tf.parent_frame_id == "world"
 
 
 def test_every_message_valid_for_independent_readers(trial_file):
@@ -285,7 +282,7 @@ def test_every_message_valid_for_independent_readers(trial_file):
         reader = make_reader(f)
         summary = reader.get_summary()
         metadata = list(reader.iter_metadata())
-    assert counts["/tf"] == 4 * RATE_HZ * DURATION_S and counts["/result"] == 1 and counts["/grasp_pose"] == 1
+    assert counts["/tf"] == RATE_HZ * DURATION_S and counts["/result"] == 1 and counts["/grasp_pose"] == 1
     assert [m.name for m in metadata] == ["graspexp"] and metadata[0].metadata == METADATA
     names = sorted(s.name for s in summary.schemas.values())
     assert names == sorted(S.TOPIC_SCHEMAS.values())  # each schema registered once
@@ -398,7 +395,7 @@ def _small_log() -> bytes:
     w.transforms(0.0, {"object": ((0, 0, 0.1), QUAT_Z90_WXYZ)})
     w.contacts(
         0.0,
-        [{"body0": "object", "body1": "table", "position": (0, 0, 0), "normal": (0, 0, 1), "force_n": 1.0}],
+        [{"body0": "object", "body1": "support", "position": (0, 0, 0), "normal": (0, 0, 1), "force_n": 1.0}],
     )
     w.result(0.5, _result())
     w.finish()
@@ -526,3 +523,28 @@ def test_replay_resim_delegates(trial_file, monkeypatch, capsys):
     assert replay.main([str(trial_file), "--resim"]) == 1
     assert "resim: DISAGREES: object dropped" in capsys.readouterr().out
     assert replay.main([str(trial_file)]) == 0  # without the flag, resim is never imported
+
+
+def test_old_json_format_log_result_reads_and_trial_is_refused_in_one_line(tmp_path):
+    """A log of the format before the Foxglove SDK (JSON /tf): report/compare/resume read its result; replay
+    refuses it with one line naming the older format."""
+    from mcap.writer import Writer
+
+    path = tmp_path / "old.mcap"
+    with open(path, "wb") as f:
+        w = Writer(f)
+        w.start(profile="", library="graspexp; mcap")
+        w.add_metadata(S.METADATA_NAME, METADATA)
+        tf_schema = w.register_schema("foxglove.FrameTransform", "jsonschema", b'{"type":"object"}')
+        tf = w.register_channel("/tf", "json", tf_schema)
+        result_schema = w.register_schema(S.TRIAL_RESULT, "jsonschema", S.schema_bytes(S.TRIAL_RESULT))
+        result = w.register_channel("/result", "json", result_schema)
+        w.add_message(tf, log_time=0, publish_time=0, data=b'{"child_frame_id":"object"}')
+        w.add_message(result, log_time=1, publish_time=1, data=json.dumps(_result()).encode())
+        w.finish()
+    assert read_result(path)["reason"] == "slipped"
+    with pytest.raises(OldLogFormatError, match=r"old\.mcap: .*older format") as info:
+        read_trial(path)
+    assert "\n" not in str(info.value)
+    proc = _replay(str(path))
+    assert proc.returncode == 2 and len(proc.stderr.splitlines()) == 1 and "older format" in proc.stderr

@@ -66,9 +66,9 @@ def test_job_writes_one_log_per_trial_and_a_results_table(two_runs):
 
 def test_log_reads_back_with_expected_topics_and_schemas(two_runs):
     log = read_trial(two_runs[0] / "trials" / "can" / "000.mcap")
-    assert log.topics["/tf"] == "foxglove.FrameTransform"
+    assert log.topics["/tf"] == "foxglove.FrameTransforms"
     assert log.topics["/scene"] == "foxglove.SceneUpdate"
-    assert log.topics["/contacts"] == "graspexp.Contacts@1"
+    assert log.topics["/contacts"] == "foxglove.PointCloud"
     assert log.topics["/grasp"] == "graspexp.PlannedGrasp@1"
     assert log.topics["/result"] == "graspexp.TrialResult@2"
     assert {"object", "palm", "finger_left", "finger_right"} <= set(log.transforms)

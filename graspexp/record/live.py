@@ -37,7 +37,7 @@ def live_channels(port: int) -> Channels:
 
 def live_port(port: int) -> int:
     """The port the server started by ``live_channels(port)`` listens on."""
-    return _SERVERS[port][0].port()
+    return _SERVERS[port][0].port
 
 
 def stop_live(port: int) -> None:

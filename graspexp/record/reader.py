@@ -137,6 +137,9 @@ class _Log:
         }
         self.metadata = [r for r in records if isinstance(r, Metadata) and r.name == S.METADATA_NAME]
         self.messages = sorted((r for r in records if isinstance(r, Message)), key=lambda m: m.log_time)
+        contacts = [ch for ch in self.channels.values() if ch.topic == S.TOPIC_CONTACTS]
+        self.bodies = contacts[0].metadata.get("bodies", "").split(",") if contacts else []
+        """The /contacts body names, by index (stored with the channel)."""
         self._protobuf = DecoderFactory()
         self._decoders: dict[int, Callable[[bytes], Any]] = {}
         tf = [ch for ch in self.channels.values() if ch.topic == S.TOPIC_TF]
@@ -219,6 +222,35 @@ def _entity(e: Any) -> dict:
     }
 
 
+_CONTACT_DTYPE = np.dtype(
+    {
+        "names": [*S.CONTACT_FLOATS, *S.CONTACT_BODIES],
+        "formats": ["<f4"] * len(S.CONTACT_FLOATS) + ["u1"] * len(S.CONTACT_BODIES),
+        "itemsize": S.CONTACT_STRIDE,
+    }
+)
+
+
+def _contacts(cloud: Any, bodies: list[str]) -> list[dict]:
+    """A /contacts foxglove.PointCloud as dicts: body0, body1, position [3], normal [3], force_n [3], separation_m."""
+    names = [f.name for f in cloud.fields]
+    if cloud.point_stride != S.CONTACT_STRIDE or names != list(_CONTACT_DTYPE.names):
+        raise ValueError(f"contact layout {names} / stride {cloud.point_stride} is not graspexp's")
+    rows = np.frombuffer(cloud.data, dtype=_CONTACT_DTYPE)
+    floats = np.stack([rows[n] for n in S.CONTACT_FLOATS], axis=1).astype(float).tolist()
+    return [
+        {
+            "body0": bodies[b0],
+            "body1": bodies[b1],
+            "position": f[0:3],
+            "normal": f[3:6],
+            "force_n": f[6:9],
+            "separation_m": f[9],
+        }
+        for f, b0, b1 in zip(floats, rows["body0"].tolist(), rows["body1"].tolist(), strict=True)
+    ]
+
+
 def read_trial(source: Path | str | IO[bytes], *, require_result: bool = True) -> TrialLog:
     """Read a whole trial log from a path or a binary stream (e.g. io.BytesIO).
 
@@ -253,12 +285,13 @@ def read_trial(source: Path | str | IO[bytes], *, require_result: bool = True) -
         t_s = m.log_time / 1e9
         try:
             if topic == S.TOPIC_TF:
-                tr, rot = msg.translation, msg.rotation
-                tf.setdefault(msg.child_frame_id, []).append(
-                    [t_s, tr.x, tr.y, tr.z, rot.w, rot.x, rot.y, rot.z]
-                )
+                for f in msg.transforms:
+                    tr, rot = f.translation, f.rotation
+                    tf.setdefault(f.child_frame_id, []).append(
+                        [t_s, tr.x, tr.y, tr.z, rot.w, rot.x, rot.y, rot.z]
+                    )
             elif topic == S.TOPIC_CONTACTS:
-                log.contacts.append((t_s, list(msg["contacts"])))
+                log.contacts.append((t_s, _contacts(msg, parsed.bodies)))
             elif topic == S.TOPIC_PHASE:
                 log.phases.append((t_s, str(msg["name"]), msg.get("info")))
             elif topic == S.TOPIC_GRASP:

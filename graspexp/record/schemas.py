@@ -1,6 +1,6 @@
 """Topics of a trial log, and the JSON Schemas of graspexp's own messages with the NaN <-> null convention.
 
-The Foxglove topics (``/tf``, ``/scene``, ``/grasp_pose``) carry Foxglove's own protobuf schemas, written
+The Foxglove topics (``/tf``, ``/scene``, ``/grasp_pose``, ``/contacts``) carry Foxglove's own protobuf schemas, written
 by the ``foxglove-sdk`` package (see :mod:`graspexp.record.writer`); nothing here copies them. The
 ``graspexp.*@N`` schemas are our own JSON Schemas for what no Foxglove schema covers: bump ``N`` whenever a
 field changes meaning or is removed.
@@ -18,7 +18,9 @@ import math
 import types
 import typing
 
+from graspexp.sim.gripper import FINGER_NAMES, PALM_NAME
 from graspexp.sim.outcome import TrialResult
+from graspexp.sim.scene import GROUND_NAME, OBJECT_NAME, SUPPORT_NAME
 
 SCHEMA_ENCODING = "jsonschema"
 MESSAGE_ENCODING = "json"
@@ -26,10 +28,10 @@ MESSAGE_ENCODING = "json"
 PROTOBUF = "protobuf"
 """Schema and message encoding of the Foxglove topics."""
 
-FRAME_TRANSFORM = "foxglove.FrameTransform"
+FRAME_TRANSFORMS = "foxglove.FrameTransforms"
 SCENE_UPDATE = "foxglove.SceneUpdate"
 POSE_IN_FRAME = "foxglove.PoseInFrame"
-CONTACTS = "graspexp.Contacts@1"
+POINT_CLOUD = "foxglove.PointCloud"
 PLANNED_GRASP = "graspexp.PlannedGrasp@1"
 PHASE = "graspexp.Phase@1"
 TRIAL_RESULT = "graspexp.TrialResult@2"
@@ -44,9 +46,9 @@ TOPIC_RESULT = "/result"
 
 TOPIC_SCHEMAS: dict[str, str] = {
     TOPIC_SCENE: SCENE_UPDATE,
-    TOPIC_TF: FRAME_TRANSFORM,
+    TOPIC_TF: FRAME_TRANSFORMS,
     TOPIC_GRASP_POSE: POSE_IN_FRAME,
-    TOPIC_CONTACTS: CONTACTS,
+    TOPIC_CONTACTS: POINT_CLOUD,
     TOPIC_GRASP: PLANNED_GRASP,
     TOPIC_PHASE: PHASE,
     TOPIC_RESULT: TRIAL_RESULT,
@@ -73,6 +75,28 @@ PHASE_NAMES = (
 METADATA_NAME = "graspexp"
 """Name of the MCAP metadata record holding the resolved config, seeds and versions."""
 
+CONTACT_FLOATS = (
+    "x",
+    "y",
+    "z",
+    "normal_x",
+    "normal_y",
+    "normal_z",
+    "force_x",
+    "force_y",
+    "force_z",
+    "separation",
+)
+"""/contacts is a foxglove.PointCloud in the world frame, one point per touching body pair: these float32
+fields (position m, unit normal, force on body0 N, signed separation m), then ``body0`` and ``body1`` as
+uint8 indices into :data:`BODY_NAMES`, padded to :data:`CONTACT_STRIDE` bytes."""
+CONTACT_BODIES = ("body0", "body1")
+CONTACT_STRIDE = 4 * len(CONTACT_FLOATS) + 4
+CONTACT_FORMAT = f"<{len(CONTACT_FLOATS)}f2B2x"
+"""struct format of one /contacts point (little-endian)."""
+BODY_NAMES = (OBJECT_NAME, SUPPORT_NAME, GROUND_NAME, PALM_NAME, *FINGER_NAMES)
+"""The bodies that can touch; also stored as the /contacts channel's metadata ``bodies`` (comma-separated)."""
+
 _NUMBER_OR_NAN = {"type": ["number", "null"], "description": "null encodes NaN"}
 
 
@@ -95,32 +119,6 @@ def _vec3(description: str) -> dict:
         "minItems": 3,
         "maxItems": 3,
         "description": description,
-    }
-
-
-def _contacts() -> dict:
-    contact = {
-        "type": "object",
-        "properties": {
-            "body0": {"type": "string", "description": "Name of the first body"},
-            "body1": {"type": "string", "description": "Name of the second body"},
-            "position": _vec3("Contact point, world frame, m"),
-            "normal": _vec3("Unit contact normal, world frame, as the simulator reports it"),
-            "force_n": _vec3("Contact force on body0 (simulator impulse / time step), world frame, N"),
-            "separation_m": {**_NUMBER_OR_NAN, "description": "Signed distance, m (negative: penetration)"},
-        },
-        "required": ["body0", "body1", "position", "normal", "force_n", "separation_m"],
-    }
-    return {
-        "$schema": "https://json-schema.org/draft/2020-12/schema",
-        "title": CONTACTS,
-        "description": "All contact points of one simulation step. Magnitude: the norm of `force_n`.",
-        "type": "object",
-        "properties": {
-            "timestamp": _time("Simulation time of the step"),
-            "contacts": {"type": "array", "items": contact},
-        },
-        "required": ["timestamp", "contacts"],
     }
 
 
@@ -209,7 +207,6 @@ def _trial_result() -> dict:
 
 
 SCHEMAS: dict[str, dict] = {
-    CONTACTS: _contacts(),
     PLANNED_GRASP: _planned_grasp(),
     PHASE: _phase(),
     TRIAL_RESULT: _trial_result(),

@@ -1,9 +1,9 @@
 """Write one trial to MCAP: Foxglove scene and transforms, contacts, the planned grasp, phases, the result.
 
 The file is written by the official ``foxglove-sdk`` package (its Rust MCAP writer): ``/tf``
-(foxglove.FrameTransform), ``/scene`` (foxglove.SceneUpdate) and ``/grasp_pose`` (foxglove.PoseInFrame)
-are protobuf messages with Foxglove's own schemas; ``/contacts``, ``/grasp``, ``/phase`` and ``/result``
-are JSON with our own JSON Schemas (:mod:`graspexp.record.schemas`). log_time and publish_time are the
+(foxglove.FrameTransforms), ``/scene`` (foxglove.SceneUpdate), ``/grasp_pose`` (foxglove.PoseInFrame) and
+``/contacts`` (foxglove.PointCloud) are protobuf messages with Foxglove's own schemas; ``/grasp``,
+``/phase`` and ``/result`` are JSON with our own JSON Schemas (:mod:`graspexp.record.schemas`). log_time and publish_time are the
 SIMULATION time in integer nanoseconds, so writing the same trial twice gives byte-identical files
 (nothing in the file depends on the wall clock). Chunks are LZ4-compressed and carry CRCs; the data
 section and the summary carry CRCs too, so the reader detects truncation and corruption.
@@ -20,6 +20,7 @@ import enum
 import json
 import math
 import os
+import struct
 from collections.abc import Mapping, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
@@ -27,10 +28,19 @@ from typing import IO, Any
 
 import foxglove
 import numpy as np
-from foxglove.channels import FrameTransformChannel, PoseInFrameChannel, SceneUpdateChannel
+from foxglove.channels import (
+    FrameTransformsChannel,
+    PointCloudChannel,
+    PoseInFrameChannel,
+    SceneUpdateChannel,
+)
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 from foxglove.messages import (
     FrameTransform,
+    FrameTransforms,
+    PackedElementField,
+    PackedElementFieldNumericType,
+    PointCloud,
     Pose,
     PoseInFrame,
     Quaternion,
@@ -49,9 +59,16 @@ from graspexp.record import schemas as S
 CHUNK_SIZE_BYTES = 1024 * 1024
 """Uncompressed chunk size; a typical trial fits in one chunk."""
 
-CONTACT_DECIMALS = {"position": 6, "normal": 6, "force_n": 4, "separation_m": 7}
-"""Decimals kept per /contacts quantity (m, unit, N, m): the bulk of a log.
-/tf, /grasp and /result keep full float64 precision."""
+_CONTACT = struct.Struct(S.CONTACT_FORMAT)
+_BODY_IDS = {name: i for i, name in enumerate(S.BODY_NAMES)}
+_CONTACT_FIELDS = [
+    PackedElementField(name=n, offset=4 * i, type=PackedElementFieldNumericType.Float32)
+    for i, n in enumerate(S.CONTACT_FLOATS)
+] + [
+    PackedElementField(name=n, offset=4 * len(S.CONTACT_FLOATS) + i, type=PackedElementFieldNumericType.Uint8)
+    for i, n in enumerate(S.CONTACT_BODIES)
+]
+_IDENTITY = Pose(position=Vector3(), orientation=Quaternion(w=1.0))
 
 PARTIAL_SUFFIX = ".partial"
 WORLD_FRAME = "world"
@@ -97,7 +114,10 @@ class Channels:
 
     def __init__(self, context: foxglove.Context):
         self.context = context
-        self.tf = FrameTransformChannel(S.TOPIC_TF, context=context)
+        self.tf = FrameTransformsChannel(S.TOPIC_TF, context=context)
+        self.contacts = PointCloudChannel(
+            S.TOPIC_CONTACTS, metadata={"bodies": ",".join(S.BODY_NAMES)}, context=context
+        )
         self.scene = SceneUpdateChannel(S.TOPIC_SCENE, context=context)
         self.grasp_pose = PoseInFrameChannel(S.TOPIC_GRASP_POSE, context=context)
         self.json = {
@@ -112,27 +132,23 @@ class Channels:
         }
 
 
-def _round(values: Sequence[float], digits: int) -> list[float]:
-    return [round(float(v), digits) for v in values]
-
-
-def _contact_json(c: Mapping[str, Any]) -> dict:
-    """One /contacts entry in plain rounded floats (see :data:`CONTACT_DECIMALS`)."""
-    d = CONTACT_DECIMALS
-    normal = [float(v) for v in c["normal"]]
+def _contact_point(c: Mapping[str, Any]) -> bytes:
+    """One /contacts point (see :data:`graspexp.record.schemas.CONTACT_FLOATS`) from a contact mapping."""
     position = [float(v) for v in c["position"]]
+    normal = [float(v) for v in c["normal"]]
     force = c["force_n"]
-    force = [float(force) * n for n in normal] if np.ndim(force) == 0 else [float(v) for v in force]
+    force = (
+        [float(v) for v in force]
+        if isinstance(force, Sequence | np.ndarray)
+        else [float(force) * n for n in normal]
+    )
     if not len(position) == len(normal) == len(force) == 3:
         raise ValueError(f"contact position, normal and force_n must have 3 components, got {dict(c)!r}")
-    return {
-        "body0": str(c["body0"]),
-        "body1": str(c["body1"]),
-        "position": _round(position, d["position"]),
-        "normal": _round(normal, d["normal"]),
-        "force_n": _round(force, d["force_n"]),
-        "separation_m": round(float(c.get("separation_m", 0.0)), d["separation_m"]),
-    }
+    try:
+        bodies = _BODY_IDS[c["body0"]], _BODY_IDS[c["body1"]]
+    except KeyError as exc:
+        raise ValueError(f"contact body {exc.args[0]!r} is not one of {S.BODY_NAMES}") from None
+    return _CONTACT.pack(*position, *normal, *force, float(c.get("separation_m", 0.0)), *bodies)
 
 
 def _dumps(message: Any) -> bytes:
@@ -193,40 +209,47 @@ class TrialWriter:
         self._ch.scene.log(SceneUpdate(deletions=deletions), log_time=ns)
 
     def transforms(self, t_s: float, frames: Mapping[str, tuple[Sequence[float], Sequence[float]]]) -> None:
-        """/tf, one foxglove.FrameTransform per child frame, parent ``world``.
+        """/tf, one foxglove.FrameTransforms message: a FrameTransform per child frame, parent ``world``.
 
         frames : child frame -> (position (3,) world frame m, quaternion (4,) SAPIEN order w, x, y, z).
         The rotation is written in Foxglove order (x, y, z, w). The hot path of a trial log: plain floats.
         """
         ns = self._ns(t_s)
         ts = Timestamp(*divmod(ns, 1_000_000_000))
-        log = self._ch.tf.log
+        out = []
         for child, (pos, quat_wxyz) in frames.items():
-            x, y, z = (float(v) for v in pos)
-            qw, qx, qy, qz = (float(v) for v in quat_wxyz)
-            log(
+            x, y, z = np.asarray(pos, dtype=float).tolist()
+            qw, qx, qy, qz = np.asarray(quat_wxyz, dtype=float).tolist()
+            out.append(
                 FrameTransform(
                     timestamp=ts,
                     parent_frame_id=WORLD_FRAME,
                     child_frame_id=child,
                     translation=Vector3(x=x, y=y, z=z),
                     rotation=Quaternion(x=qx, y=qy, z=qz, w=qw),
-                ),
-                log_time=ns,
+                )
             )
-
-    # -- our own topics (JSON) ----------------------------------------------------------------------
+        self._ch.tf.log(FrameTransforms(transforms=out), log_time=ns)
 
     def contacts(self, t_s: float, contacts: Sequence[Mapping[str, Any]]) -> None:
-        """/contacts, graspexp.Contacts@1: one message with every contact of the step.
+        """/contacts, foxglove.PointCloud in ``world``: one point per contact (drawn in Foxglove's 3D panel).
 
-        Each mapping: body0, body1 (names), position (3,) world m, normal (3,) world, force_n: (3,)
-        world-frame force on body0 in N, or a scalar magnitude along ``normal``; separation_m (float,
-        default 0). Numbers are rounded to CONTACT_DECIMALS decimals per quantity: 1 um positions, 1e-6
-        normals, 0.1 mN forces, 0.1 um separations.
+        Each mapping: body0, body1 (names from :data:`graspexp.record.schemas.BODY_NAMES`), position (3,)
+        world m, normal (3,) world, force_n: (3,) world-frame force on body0 in N, or a scalar magnitude
+        along ``normal``; separation_m (float, default 0). Stored as float32, as PhysX reports contacts.
         """
-        msg = {"timestamp": stamp(t_s), "contacts": [_contact_json(c) for c in contacts]}
-        self._json(S.TOPIC_CONTACTS, t_s, msg)
+        ns = self._ns(t_s)
+        cloud = PointCloud(
+            timestamp=Timestamp(*divmod(ns, 1_000_000_000)),
+            frame_id=WORLD_FRAME,
+            pose=_IDENTITY,
+            point_stride=S.CONTACT_STRIDE,
+            fields=_CONTACT_FIELDS,
+            data=b"".join(_contact_point(c) for c in contacts),
+        )
+        self._ch.contacts.log(cloud, log_time=ns)
+
+    # -- our own topics (JSON) ----------------------------------------------------------------------
 
     def grasp(self, t_s: float, grasp: Mapping[str, Any]) -> None:
         """/grasp, graspexp.PlannedGrasp@1, and the same pose on /grasp_pose (foxglove.PoseInFrame, ``world``).
