@@ -548,3 +548,21 @@ def test_old_json_format_log_result_reads_and_trial_is_refused_in_one_line(tmp_p
     assert "\n" not in str(info.value)
     proc = _replay(str(path))
     assert proc.returncode == 2 and len(proc.stderr.splitlines()) == 1 and "older format" in proc.stderr
+
+
+def test_foxglove_layout_shows_the_logged_topics():
+    """The saved layout names only panels it defines and topics a trial log has."""
+    layout = json.loads((Path(S.__file__).parent / "foxglove_layout.json").read_text())
+
+    def leaves(node):
+        return [node] if isinstance(node, str) else leaves(node["first"]) + leaves(node["second"])
+
+    panels = leaves(layout["layout"])
+    assert sorted(panels) == sorted(layout["configById"])
+    used = set(layout["configById"]["3D!graspexp"]["topics"])
+    for panel in panels:
+        cfg = layout["configById"][panel]
+        used |= {cfg["topicPath"]} if "topicPath" in cfg else set()
+        used |= {p["value"].split(".")[0] for p in cfg.get("paths", [])}
+    assert used == {"/scene", "/contacts", "/grasp_pose", "/phase", "/result", "/grasp"}
+    assert used <= set(S.TOPIC_SCHEMAS)

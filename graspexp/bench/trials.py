@@ -60,6 +60,7 @@ class _Object:
             "cpu": cpu,
             "success": res.success,
             "sim_time_s": res.sim_time_s,
+            "steps": res.steps,
             **res.timings_s,
         }
 
@@ -116,12 +117,20 @@ def report_mode(mode: str, rows: dict[str, list[dict]], log_rate_hz: float) -> N
     )
     per_tick = _median(logged, lambda r: 1e6 * r["log"] / max(1.0, r["sim_time_s"] * log_rate_hz))
     for label, rs, target in (("logged", logged, TARGET_LOGGED), ("unlogged", bare, TARGET_UNLOGGED)):
-        wall = _median(rs, lambda r: r["wall"] / r["physics"])
-        cpu = _median(rs, lambda r: r["cpu"] / r["physics"])
+        ratio = _median(rs, lambda r: r["wall"] / r["physics"])
+        busy = _median(rs, lambda r: r["cpu"] / r["wall"])
         print(
-            f"  overhead ratio {label:<8} (trial / physics steps): median {wall:.3f} wall, {cpu:.3f} CPU"
-            f"  (target <= {target})"
+            f"  overhead ratio {label:<8} (trial / physics steps): median {ratio:.3f}  (target <= {target};"
+            f" CPU/wall {busy:.2f}: below ~0.9 the machine is busy and figures scatter)"
         )
+    loop = _median(bare, lambda r: 1e6 * (r["settle"] + r["execute"] - r["physics"]) / max(1, r["steps"]))
+    split = {ph: _median(bare, lambda r, ph=ph: r[ph] / r["physics"]) for ph in ("build", "plan", "quality")}
+    split["step loop"] = _median(bare, lambda r: (r["settle"] + r["execute"] - r["physics"]) / r["physics"])
+    print(
+        "  unlogged overhead as fractions of the physics time: "
+        + ", ".join(f"{ph} {v:.3f}" for ph, v in split.items())
+        + f" ({loop:.1f} us per step)"
+    )
     print(
         f"  logging per {log_rate_hz:g} Hz tick (transforms, contacts, their messages): median {per_tick:.1f} us"
     )

@@ -218,8 +218,10 @@ class TrialWriter:
         ts = Timestamp(*divmod(ns, 1_000_000_000))
         out = []
         for child, (pos, quat_wxyz) in frames.items():
-            x, y, z = np.asarray(pos, dtype=float).tolist()
-            qw, qx, qy, qz = np.asarray(quat_wxyz, dtype=float).tolist()
+            x, y, z = pos.tolist() if isinstance(pos, np.ndarray) else map(float, pos)
+            qw, qx, qy, qz = (
+                quat_wxyz.tolist() if isinstance(quat_wxyz, np.ndarray) else map(float, quat_wxyz)
+            )
             out.append(
                 FrameTransform(
                     timestamp=ts,

@@ -76,15 +76,17 @@ def contact_records(contacts: list, dt: float) -> list[dict]:
         w_sum = px = py = pz = nx = ny = nz = fx = fy = fz = 0.0
         sep = math.inf
         for p in c.points:
+            sep = min(sep, p.separation)
             ix, iy, iz = p.impulse.tolist()
             w = math.sqrt(ix * ix + iy * iy + iz * iz)
+            if w == 0.0:
+                continue
             x, y, z = p.position.tolist()
             a, b, d = p.normal.tolist()
             w_sum += w
             px, py, pz = px + w * x, py + w * y, pz + w * z
             nx, ny, nz = nx + w * a, ny + w * b, nz + w * d
             fx, fy, fz = fx + ix, fy + iy, fz + iz
-            sep = min(sep, p.separation)
         if w_sum <= MIN_IMPULSE_NS:
             continue
         n = math.sqrt(nx * nx + ny * ny + nz * nz) or w_sum

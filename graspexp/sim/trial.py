@@ -115,6 +115,7 @@ class _Sim:
         self.t, self.steps = 0.0, 0
         self.log_every = max(1, round(1.0 / (cfg.sim.log_rate_hz * self.dt)))
         self.gripper: Gripper | None = None
+        self._links: list | None = None
         self.touch: SupportTouch | None = None
         self.touched_support = False
         self.max_speed_sq = float(cfg.sim.max_speed_mps) ** 2
@@ -162,13 +163,15 @@ class _Sim:
             self.log()
 
     def frames(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-        """World poses (position, quaternion wxyz) of the logged frames."""
+        """World poses (position (3,) m, quaternion wxyz (4,)) of the logged frames."""
         p = self.ts.object_entity.pose
         out = {"object": (p.p, p.q)}
         if self.gripper is not None:
-            for link in (self.gripper.palm, *self.gripper.fingers):
+            if self._links is None:
+                self._links = [(link.name, link) for link in (self.gripper.palm, *self.gripper.fingers)]
+            for name, link in self._links:
                 lp = link.entity_pose
-                out[link.name] = (lp.p, lp.q)
+                out[name] = (lp.p, lp.q)
         return out
 
     def log(self) -> None:
