@@ -125,6 +125,8 @@ class _Sim:
         self._contacts = ts.scene.physx_system.get_contacts
         body = ts.object_body
         self._velocities = (body.get_linear_velocity, body.get_angular_velocity)
+        self.speed_sq = (0.0, 0.0)
+        """The object's squared linear (m^2/s^2) and angular (rad^2/s^2) speed after the last step."""
 
     def watch_support(self, gripper: Gripper) -> None:
         """From now on a gripper link touching the support fails the trial (COLLISION_SUPPORT)."""
@@ -146,7 +148,7 @@ class _Sim:
         self.t = self.steps * self.dt
         linear, angular = self._velocities
         v, w = linear(), angular()
-        vv, ww = v.dot(v), w.dot(w)
+        vv, ww = self.speed_sq = v.dot(v), w.dot(w)
         if not (vv <= self.max_speed_sq and ww < 1e12):  # NaN fails every comparison
             raise TrialFailed(
                 FailureReason.SIM_UNSTABLE, f"object speed {float(vv) ** 0.5:.3g} m/s at t={self.t:.3f} s"
@@ -198,17 +200,15 @@ class _Sim:
 def _settle(sim: _Sim) -> bool:
     """Step until the object rests, falls below the support, or the time cap; True if it is on the support."""
     cfg = sim.cfg.sim
-    body, entity = sim.ts.object_body, sim.ts.object_entity
+    body = sim.ts.object_body
     min_steps = int(cfg.settle_min_s / sim.dt)
     below_z = sim.ts.table_z - FELL_BELOW_M
+    linear_sq, angular_sq = cfg.settle_linear_mps**2, cfg.settle_angular_radps**2
     for _ in range(int(cfg.settle_max_s / sim.dt)):
         sim.step()
-        if entity.pose.p[2] < below_z:
+        if body.get_entity_pose().p[2] < below_z:
             return False
-        if sim.steps >= min_steps and (
-            np.linalg.norm(body.linear_velocity) < cfg.settle_linear_mps
-            and np.linalg.norm(body.angular_velocity) < cfg.settle_angular_radps
-        ):
+        if sim.steps >= min_steps and sim.speed_sq[0] < linear_sq and sim.speed_sq[1] < angular_sq:
             break
     return _on_support(sim.ts, sim.cfg)
 
