@@ -149,3 +149,14 @@ def test_collab_log_valid_and_deletes_the_support_when_removed(collab_log):
     assert set(cube) == {"pose", "size", "color"} and set(cube["pose"]) == {"position", "orientation"}
     (tri,) = static[1]["triangles"]
     assert set(tri["points"][0]) == {"x", "y", "z"} and len(tri["indices"]) % 3 == 0
+
+
+def test_trial_bench_prints_both_ratios_for_both_modes(capsys):
+    from graspexp.bench.trials import main
+
+    main(["--objects", "can", "--trials", "1", "--repeats", "0"])
+    out = capsys.readouterr().out
+    for mode in ("collab", "bin"):
+        block = out.split(f"[{mode}]")[1]
+        assert "overhead ratio logged" in block and "overhead ratio unlogged" in block
+        assert "logging per 30 Hz tick" in block and "step loop" in block
