@@ -24,17 +24,21 @@ from typing import IO, Any
 
 import numpy as np
 from mcap.exceptions import EndOfFile, InvalidMagic
+from mcap.reader import SeekingReader
 from mcap.records import Channel, DataEnd, Footer, Message, Metadata, Schema
-from mcap.stream_reader import CRCValidationError, StreamReader
+from mcap.stream_reader import MAGIC_SIZE, CRCValidationError, StreamReader
+from mcap.writer import MCAP0_MAGIC
 from mcap_protobuf.decoder import DecoderFactory
 
 from graspexp.record import schemas as S
 from graspexp.record.writer import PARTIAL_SUFFIX
 
-_FOOTER_TAIL = 4 + 8
+_FOOTER_TAIL = 4 + MAGIC_SIZE
 """Bytes after the last field the summary CRC covers: the CRC itself and the closing magic."""
 _FOOTER_SIZE = 1 + 8 + 8 + 8 + 4
 """A footer record: opcode, length, summary_start, summary_offset_start, summary_crc."""
+_DATA_END_SIZE = 1 + 8 + 4
+"""A data-end record: opcode, length, data_section_crc."""
 
 
 class CorruptLogError(ValueError):
@@ -89,30 +93,79 @@ def _reject_partial(name: str) -> None:
         )
 
 
+def _corrupt(name: str, data: bytes, exc: Exception) -> CorruptLogError:
+    """One line for a failure of the mcap library on the bytes of ``name``."""
+    if isinstance(exc, InvalidMagic):
+        return CorruptLogError(f"{name}: not an MCAP file (bad magic)")
+    if isinstance(exc, EndOfFile):
+        return CorruptLogError(f"{name}: truncated MCAP file ({len(data)} bytes)")
+    if isinstance(exc, CRCValidationError):
+        return CorruptLogError(f"{name}: corrupt MCAP file ({exc})")
+    return CorruptLogError(f"{name}: corrupt MCAP data ({type(exc).__name__}: {exc})")
+
+
+def _check_summary_crc(data: bytes, footer: Footer, name: str) -> None:
+    """The footer's summary CRC (summary section and footer fields), which the mcap library does not check."""
+    end = len(data) - _FOOTER_TAIL
+    start = footer.summary_start or end - (_FOOTER_SIZE - 4)
+    if footer.summary_crc and zlib.crc32(data[start:end]) != footer.summary_crc:
+        raise CorruptLogError(f"{name}: corrupt MCAP file (summary CRC mismatch)")
+
+
 def _records(data: bytes, name: str) -> list:
-    """Every record of the file, parsed and CRC-checked by the mcap library, plus the summary CRC."""
+    """Every record of the file, parsed and CRC-checked (chunks, data section) by the mcap library, plus the
+    summary CRC."""
     if not data:
         raise CorruptLogError(f"{name}: empty file")
     try:
         records = list(
             StreamReader(io.BytesIO(data), validate_crcs=True, record_size_limit=len(data)).records
         )
-    except InvalidMagic as exc:
-        raise CorruptLogError(f"{name}: not an MCAP file (bad magic)") from exc
-    except EndOfFile as exc:
-        raise CorruptLogError(f"{name}: truncated MCAP file ({len(data)} bytes)") from exc
-    except CRCValidationError as exc:
-        raise CorruptLogError(f"{name}: corrupt MCAP file ({exc})") from exc
-    except Exception as exc:  # any other parse failure of the bytes means a malformed file
-        raise CorruptLogError(f"{name}: corrupt MCAP data ({type(exc).__name__}: {exc})") from exc
+    except Exception as exc:  # any parse failure of the bytes means a malformed file
+        raise _corrupt(name, data, exc) from exc
     if not records or not isinstance(records[-1], Footer) or not any(isinstance(r, DataEnd) for r in records):
         raise CorruptLogError(f"{name}: truncated or unfinished MCAP file ({len(data)} bytes, no footer)")
-    footer = records[-1]
-    end = len(data) - _FOOTER_TAIL
-    start = footer.summary_start or end - (_FOOTER_SIZE - 4)
-    if footer.summary_crc and zlib.crc32(data[start:end]) != footer.summary_crc:
-        raise CorruptLogError(f"{name}: corrupt MCAP file (summary CRC mismatch)")
+    _check_summary_crc(data, records[-1], name)
     return records
+
+
+def _result_message(data: bytes, name: str) -> tuple[Channel, str, Message] | None:
+    """The last /result message, its channel and schema name, reading only the chunks that hold /result.
+
+    The mcap library parses the footer, the summary and those chunks (their CRCs); the data-section CRC in the
+    DataEnd record before the summary, which its seeking reader does not check, and the summary CRC are
+    checked here, so a change anywhere in the file is still caught. None: no /result message.
+    """
+    if not data:
+        raise CorruptLogError(f"{name}: empty file")
+    try:
+        stream = io.BytesIO(data)
+        stream.seek(-(_FOOTER_SIZE + MAGIC_SIZE), io.SEEK_END)
+        footer = next(StreamReader(stream, skip_magic=True, record_size_limit=len(data)).records)
+        if (
+            not isinstance(footer, Footer)
+            or not data.endswith(MCAP0_MAGIC)
+            or not _DATA_END_SIZE <= footer.summary_start < len(data)
+        ):
+            raise CorruptLogError(f"{name}: truncated or unfinished MCAP file ({len(data)} bytes, no footer)")
+        _check_summary_crc(data, footer, name)
+        data_end_at = footer.summary_start - _DATA_END_SIZE
+        stream.seek(data_end_at)
+        data_end = next(StreamReader(stream, skip_magic=True, record_size_limit=len(data)).records)
+        if not isinstance(data_end, DataEnd):
+            raise CorruptLogError(f"{name}: corrupt MCAP file (no data-end record before the summary)")
+        if data_end.data_section_crc and zlib.crc32(data[:data_end_at]) != data_end.data_section_crc:
+            raise CorruptLogError(f"{name}: corrupt MCAP file (data section CRC mismatch)")
+        reader = SeekingReader(io.BytesIO(data), validate_crcs=True, record_size_limit=len(data))
+        found = list(reader.iter_messages(topics=[S.TOPIC_RESULT]))
+    except CorruptLogError:
+        raise
+    except Exception as exc:  # any parse failure of the bytes means a malformed file
+        raise _corrupt(name, data, exc) from exc
+    if not found:
+        return None
+    schema, channel, message = found[-1]
+    return channel, (schema.name if schema is not None else ""), message
 
 
 def _read_bytes(source: Path | str | IO[bytes], name: str) -> bytes:
@@ -323,20 +376,14 @@ def read_trial(source: Path | str | IO[bytes], *, require_result: bool = True) -
 def read_result(path: Path | str) -> dict:
     """Only the /result message (TrialResult.to_dict() with NaN restored): the fast path for reports.
 
-    The file is checked as in :func:`read_trial`; only /result is decoded. Logs in the older JSON format
-    are read too (their /result is unchanged).
+    The whole file is CRC-checked as in :func:`read_trial`, but only the chunk holding /result is
+    decompressed and parsed. Logs in the older JSON format are read too (their /result is unchanged).
     """
     name = str(path)
-    data = _read_bytes(path, name)
-    records = _records(data, name)
-    channels = {r.id: r for r in records if isinstance(r, Channel) and r.topic == S.TOPIC_RESULT}
-    schemas = {r.id: r.name for r in records if isinstance(r, Schema)}
-    found = [r for r in records if isinstance(r, Message) and r.channel_id in channels]
-    if not found:
+    found = _result_message(_read_bytes(path, name), name)
+    if found is None:
         raise CorruptLogError(f"{name}: no /result message (the trial did not finish)")
-    message = max(found, key=lambda m: m.log_time)
-    channel = channels[message.channel_id]
-    schema_name = schemas.get(channel.schema_id, "")
+    channel, schema_name, message = found
     if schema_name != S.TRIAL_RESULT or channel.message_encoding != S.MESSAGE_ENCODING:
         raise CorruptLogError(f"{name}: /result has schema {schema_name!r}, expected {S.TRIAL_RESULT!r}")
     try:
