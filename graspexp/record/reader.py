@@ -138,15 +138,17 @@ def _result_message(data: bytes, name: str) -> tuple[Channel, str, Message] | No
     """
     if not data:
         raise CorruptLogError(f"{name}: empty file")
+    if not data.startswith(MCAP0_MAGIC):
+        raise CorruptLogError(f"{name}: not an MCAP file (bad magic)")
+    if not data.endswith(MCAP0_MAGIC):
+        raise CorruptLogError(
+            f"{name}: truncated or unfinished MCAP file ({len(data)} bytes, no closing magic)"
+        )
     try:
         stream = io.BytesIO(data)
         stream.seek(-(_FOOTER_SIZE + MAGIC_SIZE), io.SEEK_END)
         footer = next(StreamReader(stream, skip_magic=True, record_size_limit=len(data)).records)
-        if (
-            not isinstance(footer, Footer)
-            or not data.endswith(MCAP0_MAGIC)
-            or not _DATA_END_SIZE <= footer.summary_start < len(data)
-        ):
+        if not isinstance(footer, Footer) or not _DATA_END_SIZE <= footer.summary_start < len(data):
             raise CorruptLogError(f"{name}: truncated or unfinished MCAP file ({len(data)} bytes, no footer)")
         _check_summary_crc(data, footer, name)
         data_end_at = footer.summary_start - _DATA_END_SIZE
