@@ -159,4 +159,4 @@ def test_trial_bench_prints_both_ratios_for_both_modes(capsys):
     for mode in ("collab", "bin"):
         block = out.split(f"[{mode}]")[1]
         assert "overhead ratio logged" in block and "overhead ratio unlogged" in block
-        assert "logging per 30 Hz tick" in block and "step loop" in block
+        assert "logging per 30 Hz tick" in block and "execution besides physics" in block
