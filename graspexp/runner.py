@@ -23,7 +23,8 @@ from tqdm import tqdm
 
 from graspexp.config import validate
 from graspexp.datasets import DatasetError, available_objects, dataset_objects, load_object
-from graspexp.record import CorruptLogError, object_scene, read_result, trial_recorder
+from graspexp.record import CorruptLogError, read_result, trial_recorder
+from graspexp.record.scene import object_scene
 from graspexp.seeding import derive_seed
 from graspexp.sim.collision import convex_hulls
 from graspexp.sim.outcome import FailureReason, TrialResult

@@ -20,13 +20,12 @@ from graspexp.record import (
     OldLogFormatError,
     TrialRecorder,
     TrialWriter,
-    box_entity,
     iter_trial_logs,
-    mesh_entity,
     read_result,
     read_trial,
 )
 from graspexp.record import schemas as S
+from graspexp.record.scene import box_entity, mesh_entity
 from graspexp.sim.outcome import FailureReason, TrialResult
 
 METADATA = {"config": "planner:\n  name: paper\n", "seed": "7", "versions": "graspexp=0.1.0"}

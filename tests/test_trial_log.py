@@ -10,7 +10,8 @@ from conftest import compose_cfg, strictly_valid
 from mcap.reader import make_reader
 
 from graspexp.datasets import load_object
-from graspexp.record import TrialRecorder, object_scene, read_trial
+from graspexp.record import TrialRecorder, read_trial
+from graspexp.record.scene import object_scene
 from graspexp.seeding import derive_seed
 from graspexp.sim.collision import convex_hulls
 from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed

@@ -22,7 +22,8 @@ from threadpoolctl import threadpool_limits
 
 from graspexp.cli import compose_config
 from graspexp.datasets import available_objects, load_object
-from graspexp.record import TrialRecorder, object_scene
+from graspexp.record import TrialRecorder
+from graspexp.record.scene import object_scene
 from graspexp.seeding import derive_seed
 from graspexp.sim.collision import convex_hulls
 from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial, trial_seed

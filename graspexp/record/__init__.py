@@ -3,7 +3,8 @@
 Topics (log_time = simulation time in ns): ``/tf`` foxglove.FrameTransform, ``/scene``
 foxglove.SceneUpdate and ``/grasp_pose`` foxglove.PoseInFrame (protobuf, Foxglove's schemas, written by
 ``foxglove-sdk``); ``/contacts`` graspexp.Contacts@1, ``/grasp`` graspexp.PlannedGrasp@1, ``/phase``
-graspexp.Phase@1, ``/result`` graspexp.TrialResult@2 (JSON, our own JSON Schemas).
+graspexp.Phase@1, ``/result`` graspexp.TrialResult@2 (JSON, our own JSON Schemas). The scene entities are
+built by :mod:`graspexp.record.scene` (imported on its own: it needs the simulator's geometry).
 """
 
 from graspexp.record.reader import (
@@ -14,20 +15,15 @@ from graspexp.record.reader import (
     read_result,
     read_trial,
 )
-from graspexp.record.scene import ObjectScene, box_entity, mesh_entity, object_scene
 from graspexp.record.writer import TrialRecorder, TrialWriter, trial_recorder
 
 __all__ = [
     "CorruptLogError",
-    "ObjectScene",
     "OldLogFormatError",
     "TrialLog",
     "TrialRecorder",
     "TrialWriter",
-    "box_entity",
     "iter_trial_logs",
-    "mesh_entity",
-    "object_scene",
     "read_result",
     "read_trial",
     "trial_recorder",

@@ -31,7 +31,6 @@ from mcap.writer import MCAP0_MAGIC
 from mcap_protobuf.decoder import DecoderFactory
 
 from graspexp.record import schemas as S
-from graspexp.record.writer import PARTIAL_SUFFIX
 
 _FOOTER_TAIL = 4 + MAGIC_SIZE
 """Bytes after the last field the summary CRC covers: the CRC itself and the closing magic."""
@@ -87,9 +86,9 @@ def _name(source: Any) -> str:
 
 
 def _reject_partial(name: str) -> None:
-    if name.endswith(PARTIAL_SUFFIX):
+    if name.endswith(S.PARTIAL_SUFFIX):
         raise CorruptLogError(
-            f"{name}: unfinished trial log (a {PARTIAL_SUFFIX} file: the writer did not finish)"
+            f"{name}: unfinished trial log (a {S.PARTIAL_SUFFIX} file: the writer did not finish)"
         )
 
 
@@ -408,5 +407,5 @@ def iter_trial_logs(run_dir: Path | str) -> Iterator[Path]:
     ``.partial`` files (unfinished trials) are skipped.
     """
     trials = Path(run_dir) / "trials"
-    paths = [p for p in trials.glob("*/*.mcap") if p.is_file() and not p.name.endswith(PARTIAL_SUFFIX)]
+    paths = [p for p in trials.glob("*/*.mcap") if p.is_file() and not p.name.endswith(S.PARTIAL_SUFFIX)]
     yield from sorted(paths, key=_trial_sort_key)

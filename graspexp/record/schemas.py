@@ -18,9 +18,7 @@ import math
 import types
 import typing
 
-from graspexp.sim.gripper import FINGER_NAMES, PALM_NAME
 from graspexp.sim.outcome import TrialResult
-from graspexp.sim.scene import GROUND_NAME, OBJECT_NAME, SUPPORT_NAME
 
 SCHEMA_ENCODING = "jsonschema"
 MESSAGE_ENCODING = "json"
@@ -89,13 +87,14 @@ CONTACT_FLOATS = (
 )
 """/contacts is a foxglove.PointCloud in the world frame, one point per touching body pair: these float32
 fields (position m, unit normal, force on body0 N, signed separation m), then ``body0`` and ``body1`` as
-uint8 indices into :data:`BODY_NAMES`, padded to :data:`CONTACT_STRIDE` bytes."""
+uint8 indices into the body names stored as the channel's metadata ``bodies`` (comma-separated; see
+:func:`graspexp.record.writer.body_names`), padded to :data:`CONTACT_STRIDE` bytes."""
 CONTACT_BODIES = ("body0", "body1")
 CONTACT_STRIDE = 4 * len(CONTACT_FLOATS) + 4
 CONTACT_FORMAT = f"<{len(CONTACT_FLOATS)}f2B2x"
 """struct format of one /contacts point (little-endian)."""
-BODY_NAMES = (OBJECT_NAME, SUPPORT_NAME, GROUND_NAME, PALM_NAME, *FINGER_NAMES)
-"""The bodies that can touch; also stored as the /contacts channel's metadata ``bodies`` (comma-separated)."""
+PARTIAL_SUFFIX = ".partial"
+"""A log being written (or abandoned) has this suffix after ``.mcap``."""
 
 _NUMBER_OR_NAN = {"type": ["number", "null"], "description": "null encodes NaN"}
 

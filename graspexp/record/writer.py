@@ -18,6 +18,7 @@ writes a file atomically: ``<path>.partial`` first, renamed to ``path`` only on 
 """
 
 import enum
+import functools
 import json
 import math
 import os
@@ -25,7 +26,7 @@ import struct
 from collections.abc import Mapping, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, TYPE_CHECKING, Any
 
 import foxglove
 import numpy as np
@@ -53,15 +54,16 @@ from foxglove.messages import (
     Vector3,
 )
 
-from graspexp.config import JobConfig
 from graspexp.geometry import matrix_to_quat_wxyz
 from graspexp.record import schemas as S
+
+if TYPE_CHECKING:
+    from graspexp.config import JobConfig
 
 CHUNK_SIZE_BYTES = 1024 * 1024
 """Uncompressed chunk size; a typical trial fits in one chunk."""
 
 _CONTACT = struct.Struct(S.CONTACT_FORMAT)
-_BODY_IDS = {name: i for i, name in enumerate(S.BODY_NAMES)}
 _CONTACT_FIELDS = [
     PackedElementField(name=n, offset=4 * i, type=PackedElementFieldNumericType.Float32)
     for i, n in enumerate(S.CONTACT_FLOATS)
@@ -71,7 +73,7 @@ _CONTACT_FIELDS = [
 ]
 _IDENTITY = Pose(position=Vector3(), orientation=Quaternion(w=1.0))
 
-PARTIAL_SUFFIX = ".partial"
+PARTIAL_SUFFIX = S.PARTIAL_SUFFIX
 WORLD_FRAME = "world"
 
 
@@ -117,7 +119,7 @@ class Channels:
         self.context = context
         self.tf = FrameTransformsChannel(S.TOPIC_TF, context=context)
         self.contacts = PointCloudChannel(
-            S.TOPIC_CONTACTS, metadata={"bodies": ",".join(S.BODY_NAMES)}, context=context
+            S.TOPIC_CONTACTS, metadata={"bodies": ",".join(body_names())}, context=context
         )
         self.scene = SceneUpdateChannel(S.TOPIC_SCENE, context=context)
         self.grasp_pose = PoseInFrameChannel(S.TOPIC_GRASP_POSE, context=context)
@@ -133,6 +135,21 @@ class Channels:
         }
 
 
+@functools.cache
+def body_names() -> tuple[str, ...]:
+    """The physics bodies that can touch, in /contacts index order (imported here, not at module level, so
+    that reading logs does not load the simulator)."""
+    from graspexp.sim.gripper import FINGER_NAMES, PALM_NAME
+    from graspexp.sim.scene import GROUND_NAME, OBJECT_NAME, SUPPORT_NAME
+
+    return (OBJECT_NAME, SUPPORT_NAME, GROUND_NAME, PALM_NAME, *FINGER_NAMES)
+
+
+@functools.cache
+def _body_ids() -> dict[str, int]:
+    return {name: i for i, name in enumerate(body_names())}
+
+
 def _contact_point(c: Mapping[str, Any]) -> bytes:
     """One /contacts point (see :data:`graspexp.record.schemas.CONTACT_FLOATS`) from a contact mapping."""
     position = [float(v) for v in c["position"]]
@@ -146,9 +163,10 @@ def _contact_point(c: Mapping[str, Any]) -> bytes:
     if not len(position) == len(normal) == len(force) == 3:
         raise ValueError(f"contact position, normal and force_n must have 3 components, got {dict(c)!r}")
     try:
-        bodies = _BODY_IDS[c["body0"]], _BODY_IDS[c["body1"]]
+        ids = _body_ids()
+        bodies = ids[c["body0"]], ids[c["body1"]]
     except KeyError as exc:
-        raise ValueError(f"contact body {exc.args[0]!r} is not one of {S.BODY_NAMES}") from None
+        raise ValueError(f"contact body {exc.args[0]!r} is not one of {body_names()}") from None
     return _CONTACT.pack(*position, *normal, *force, float(c.get("separation_m", 0.0)), *bodies)
 
 
@@ -237,7 +255,7 @@ class TrialWriter:
     def contacts(self, t_s: float, contacts: Sequence[Mapping[str, Any]]) -> None:
         """/contacts, foxglove.PointCloud in ``world``: one point per contact (drawn in Foxglove's 3D panel).
 
-        Each mapping: body0, body1 (names from :data:`graspexp.record.schemas.BODY_NAMES`), position (3,)
+        Each mapping: body0, body1 (names from :func:`body_names`), position (3,)
         world m, normal (3,) world, force_n: (3,) world-frame force on body0 in N, or a scalar magnitude
         along ``normal``; separation_m (float, default 0). Stored as float32, as PhysX reports contacts.
         """
@@ -378,7 +396,7 @@ class TrialRecorder(TrialWriter):
 
 
 def trial_recorder(
-    path: Path | str | None, metadata: Mapping[str, str], cfg: JobConfig
+    path: Path | str | None, metadata: Mapping[str, str], cfg: "JobConfig"
 ) -> AbstractContextManager:
     """The recorder of one trial under job config ``cfg`` (its ``live`` and ``live_port`` keys).
 
