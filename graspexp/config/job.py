@@ -5,6 +5,7 @@ from typing import Any
 
 from omegaconf import MISSING
 
+from graspexp.config.constraints import BOOL, Interval, Names
 from graspexp.config.dataset import DatasetConfig
 from graspexp.config.gripper import GripperConfig
 from graspexp.config.mode import ModeConfig
@@ -51,3 +52,21 @@ class JobConfig:
     """Port of the live-view server (0: any free port)."""
     progress: bool = True
     """Show a progress bar."""
+
+
+POSE_NOISE_CONSTRAINTS = {
+    "trans_mm": [Interval(0, 1000, unit="mm")],
+    "rot_deg": [Interval(0, 180, unit="deg")],
+}
+"""Allowed values of every ``perception.noise`` key (see :mod:`graspexp.config.constraints`)."""
+
+JOB_CONSTRAINTS = {
+    "trials": [Interval(1, 100_000, integer=True)],
+    "seed": [Interval(0, 2**63 - 1, integer=True)],
+    "objects": [None, Names()],
+    "record": BOOL,
+    "live": BOOL,
+    "live_port": [Interval(0, 65535, integer=True)],
+    "progress": BOOL,
+}
+"""Allowed values of the top-level keys; the groups have their own (see :mod:`graspexp.config.constraints`)."""

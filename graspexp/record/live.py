@@ -14,8 +14,8 @@ HOST = "127.0.0.1"
 _SERVERS: dict[int, tuple[foxglove.WebSocketServer, Channels]] = {}
 
 
-class LiveViewError(OSError):
-    """The live-view server could not start (e.g. the port is taken)."""
+class LiveViewError(RuntimeError):
+    """The live-view server could not start (e.g. the port is taken): the job cannot run as asked."""
 
 
 def live_channels(port: int) -> Channels:
