@@ -3,7 +3,7 @@
 ``python -m graspexp live=true [live_port=8765]`` starts one server per process on 127.0.0.1 (loopback
 only) and every trial log's messages go to it as well as to the file, on the same topics; the app
 connects with "Open connection" -> Foxglove WebSocket -> ``ws://127.0.0.1:8765``. Each trial starts its
-clock at 0 (log time is simulation time). Off by default; when off nothing here is imported or started.
+clock at 0 (log time is simulation time). Off by default; when off no server is started.
 """
 
 import foxglove
