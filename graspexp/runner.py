@@ -24,9 +24,10 @@ from tqdm import tqdm
 
 from graspexp.config import validate
 from graspexp.datasets import DatasetError, available_objects, dataset_objects, load_object
+from graspexp.prepare import prepare_shapes
 from graspexp.record import CorruptLogError, TrialRecorder, read_result
 from graspexp.seeding import derive_seed
-from graspexp.sim.collision import convex_hulls
+from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.outcome import FailureReason, TrialResult
 from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial, scene_entities, trial_seed
 
@@ -126,7 +127,7 @@ def run_object_trials(
                     if model is None:
                         cloud_seed = derive_seed(cfg.seed, "cloud", object_name)
                         model = load_object(cfg.dataset, object_name, cfg.planner.n_points, cloud_seed)
-                        hulls = convex_hulls(model.mesh, plain.sim)
+                        hulls = collision_shape(model.mesh, plain.sim)
                         entities = scene_entities(plain, hulls)
                     result = run_trial(TrialContext(plain, model, hulls, i, seed, rec, entities))
                 except Exception as exc:  # one trial's error is recorded; the sweep goes on
@@ -179,6 +180,7 @@ def run_job(cfg: DictConfig) -> float:
 
 def _run(cfg: DictConfig, run_dir: Path) -> float:
     objects = select_objects(cfg)
+    prepare_shapes(cfg.dataset, cfg.sim, objects, cfg.progress)
     results: list[TrialResult] = []
     with tqdm(
         total=len(objects) * cfg.trials,

@@ -21,7 +21,7 @@ from graspexp.cli import compose_config
 from graspexp.datasets import available_objects, load_object
 from graspexp.record import TrialRecorder
 from graspexp.seeding import derive_seed
-from graspexp.sim.collision import convex_hulls
+from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial, trial_seed
 
 PHASES = ("build", "settle", "plan", "quality", "execute", "log")
@@ -34,7 +34,7 @@ def _run_object(args: tuple[list[str], str, int, str | None]) -> list[dict]:
     cfg = compose_config(overrides)
     plain = plain_config(cfg)
     model = load_object(cfg.dataset, name, cfg.planner.n_points, derive_seed(cfg.seed, "cloud", name))
-    hulls = convex_hulls(model.mesh, plain.sim)
+    hulls = collision_shape(model.mesh, plain.sim)
     rows = []
     for i in range(trials):
         t0 = time.perf_counter()

@@ -207,7 +207,7 @@ def _on_support(ts: TrialScene, cfg: JobConfig) -> bool:
 def scene_entities(cfg: JobConfig, hulls: list[np.ndarray]) -> list[dict]:
     """Foxglove scene entities: the support (world frame) and the object's collision hulls (object frame)."""
     from graspexp.record import box_entity, mesh_entity
-    from graspexp.sim.collision import hull_meshes
+    from graspexp.sim.collision_shapes import hull_meshes
 
     h = cfg.mode.support_height_m
     hx, hy = cfg.mode.support_half_size_m
