@@ -62,7 +62,8 @@ def prepare_shapes(
         with ProcessPoolExecutor(workers, mp_context=ctx) as pool:
             running = {pool.submit(_build_one, dataset, sim, n): n for n in missing}
             while running:
-                bar.set_postfix_str("building " + ", ".join(sorted(running.values())))
+                busy = sorted(n for f, n in running.items() if f.running())
+                bar.set_postfix_str("in work: " + ", ".join(busy) if busy else "starting workers")
                 done, _ = wait(running, timeout=REFRESH_S, return_when=FIRST_COMPLETED)
                 for fut in done:
                     name = running.pop(fut)
@@ -84,8 +85,6 @@ def _needs_build(dataset_cfg: DictConfig, sim: SimConfig | DictConfig, name: str
 def _report(bar: tqdm, result: tuple[str, float, float, int]) -> None:
     name, wall, cpu, parts = result
     log.info("collision shape of %s: %d part(s), %.1f s wall, %.1f s CPU", name, parts, wall, cpu)
-    if not bar.disable:
-        bar.write(f"  {name}: {parts} part(s), {wall:.1f} s wall, {cpu:.1f} s CPU")
     bar.update()
 
 
@@ -99,6 +98,7 @@ def main(argv: list[str] | None = None) -> None:
     from graspexp.cli import compose_config
     from graspexp.runner import select_objects
 
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
     args = list(sys.argv[1:] if argv is None else argv)
     every = "--all" in args
     cfg = compose_config([a for a in args if a != "--all"])

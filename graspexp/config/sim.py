@@ -41,17 +41,20 @@ class SimConfig:
     log_rate_hz: float = 30.0
     """Sim-time rate of transforms and contacts in the MCAP log, Hz."""
     collision_method: str = "mesh"
-    """Object collision geometry: ``mesh`` (the mesh repaired to a watertight surface, decimated, and
-    collided as a PhysX SDF triangle mesh), ``coacd`` or ``vhacd`` (convex decompositions). ``mesh`` is
-    the one within 1 mm of every staged object (90th percentile of the collision surface outside the
-    mesh: <= 0.35 mm, against 2-5 mm for CoACD); ``python -m graspexp.bench.collision_shapes`` measures it."""
+    """Object collision geometry: ``mesh`` (the mesh repaired to one closed surface, decimated, and
+    collided as a PhysX SDF triangle mesh), ``coacd`` or ``vhacd`` (convex decompositions). ``mesh`` is the
+    one within 1 mm of every staged object: 90th percentile of the collision surface outside the mesh
+    <= 0.28 mm on all 32, against 3.7-5.5 mm for CoACD at the settings below
+    (``python -m graspexp.bench.collision_shapes``)."""
     mesh_max_faces: int = 4000
-    """``mesh``: triangles kept by quadric decimation of the repaired mesh. 4000 keeps the surface within
-    0.35 mm (p90) of the scan on every staged object, at about a quarter of the contact cost of 16k."""
+    """``mesh``: triangles kept by quadric decimation of the repaired mesh; 4000 keeps the surface within
+    0.28 mm (p90) of the scan on every staged object ; undecimated (16k) meshes cost 1.5x per step in trials and
+    1500 faces pinch the mug's wall (p90 10 mm)."""
     sdf_spacing_m: float = 0.005
-    """``mesh``: PhysX SDF grid spacing, m. PhysX needs an SDF to simulate a dynamic triangle mesh, but
-    its contacts with boxes and convex shapes (support, floor, fingers, palm) use the triangles: the
-    spacing changes only the one-off cooking time (0.3 s at 4 mm, 7 s at 1 mm for the mug), not contacts."""
+    """``mesh``: PhysX SDF grid spacing, m. PhysX simulates a dynamic triangle mesh only with an SDF, but
+    computes its contacts with boxes and convex shapes (support, floor, fingers, palm) on the triangles:
+    the spacing changes the once-per-process cooking time (mug, 16k faces: 0.3 s at 4 mm, 7 s at 1 mm),
+    not the contacts (probe contacts measured identical at 1, 2 and 4 mm)."""
     coacd_threshold: float = 0.1
     """``coacd``: concavity threshold (CoACD's unit: a fraction of the bounding-box diagonal)."""
     coacd_preprocess_resolution: int = 30

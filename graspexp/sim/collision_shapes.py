@@ -11,7 +11,7 @@ Three methods (``sim.collision_method``):
 
 The cache key is the SHA-256 of the mesh content (merged vertices and faces) and the method's
 parameters, so a changed mesh or parameter never reuses a stale shape. ``mesh`` also writes the mesh as
-a binary PLY beside the cache entry: SAPIEN cooks a mesh file once per process and reuses it.
+an OBJ file beside the cache entry: SAPIEN cooks a mesh file once per process and reuses it.
 """
 
 import hashlib
@@ -42,7 +42,7 @@ class CollisionShape:
     convex: bool
     """True: every part is a convex hull (PhysX convex shapes). False: one closed triangle mesh."""
     mesh_file: Path | None = None
-    """The PLY file of the closed mesh that SAPIEN cooks once per process; None for hulls."""
+    """The OBJ file of the closed mesh that SAPIEN cooks once per process; None for hulls."""
 
     def meshes(self) -> list[trimesh.Trimesh]:
         """The parts as triangle meshes (object frame, metres)."""
@@ -115,11 +115,11 @@ def collision_shape(mesh: trimesh.Trimesh, cfg: SimConfig) -> CollisionShape:
         parts = tuple((data[f"v_{i}"], data[f"f_{i}"]) for i in range((len(data.files) - 1) // 2))
     if convex:
         return CollisionShape(params["method"], parts, True)
-    ply = path.with_suffix(".ply")
-    if not ply.exists():
-        blob = trimesh.Trimesh(*parts[0], process=False).export(file_type="ply", encoding="binary")
-        _write_atomic(ply, lambda fh: fh.write(blob))
-    return CollisionShape(params["method"], parts, False, ply)
+    obj = path.with_suffix(".obj")  # OBJ: SAPIEN 3.0.3 crashes cooking some binary PLY files (16k faces)
+    if not obj.exists():
+        text = trimesh.Trimesh(*parts[0], process=False).export(file_type="obj", include_normals=False)
+        _write_atomic(obj, lambda fh: fh.write(text.encode()))
+    return CollisionShape(params["method"], parts, False, obj)
 
 
 def _build(mesh: trimesh.Trimesh, params: dict) -> tuple[bool, list[tuple[np.ndarray, np.ndarray]]]:
