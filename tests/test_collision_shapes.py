@@ -13,9 +13,11 @@ from graspexp.sim.collision_accuracy import (
     shape_accuracy,
     signed_distance_m,
     surface_points,
+    uncovered_m,
     union_surface_points,
 )
-from graspexp.sim.collision_shapes import collision_shape, is_cached, shape_params
+from graspexp.sim.collision_shapes import CollisionShape, collision_shape, is_cached, shape_params
+from graspexp.sim.scene import build_scene
 from tests.conftest import compose_cfg
 
 R = 0.05
@@ -24,6 +26,11 @@ R = 0.05
 
 def _sphere() -> trimesh.Trimesh:
     return trimesh.creation.icosphere(subdivisions=4, radius=R)
+
+
+def _part_of(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    hull = trimesh.convex.convex_hull(vertices)
+    return np.asarray(hull.vertices, dtype=np.float32), np.asarray(hull.faces)
 
 
 def _box_vertices(half: float, centre=(0.0, 0.0, 0.0)) -> np.ndarray:
@@ -117,3 +124,42 @@ def test_default_shape_is_within_1_mm_of_real_meshes(data_root, name):
     acc = shape_accuracy(surface_points(shape, 5000, rng=np.random.default_rng(0)), mesh)
     assert acc.outside_p90_mm <= 1.0
     assert acc.inside_p90_mm <= 1.0
+
+
+@pytest.mark.sim
+def test_mesh_rests_on_the_support_and_sdf_spacing_changes_no_contact(tmp_path):
+    cfg = compose_cfg("dataset=primitives", "mode=bin")  # a wide table: the mug may roll
+    mode = OmegaConf.to_object(cfg.mode)
+    mesh = object_mesh(cfg.dataset, "mug")[0].mesh
+    lying = np.array([[1.0, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, mode.support_height_m + 0.08], [0, 0, 0, 1]])
+    poses = []
+    for spacing in (0.01, 0.003):
+        sim = SimConfig(cache_dir=str(tmp_path / str(spacing)), sdf_spacing_m=spacing)
+        shape = collision_shape(mesh, sim)
+        assert not shape.convex
+        ts = build_scene(shape, 0.2, lying, mode, sim)
+        for _ in range(480):
+            ts.scene.step()
+        poses.append(ts.object_pose())
+        lowest = (mesh.vertices @ poses[-1][:3, :3].T + poses[-1][:3, 3])[:, 2].min()
+        assert lowest == pytest.approx(mode.support_height_m, abs=5e-4)
+    # contacts with boxes use the triangles, not the SDF grid: the same landing, bit for bit
+    np.testing.assert_array_equal(poses[0], poses[1])
+
+
+def test_uncovered_distance_of_a_sphere_around_a_small_cube():
+    # sphere points outside a cube of half-size R/2: R/2 out along the axes, R (1 - sqrt(3)/2) on diagonals
+    shape = CollisionShape("coacd", (_part_of(_box_vertices(R / 2)),), True)
+    pts, _ = trimesh.sample.sample_surface(_sphere(), 4000, seed=0)
+    d = uncovered_m(pts, shape)
+    assert d.max() == pytest.approx(R / 2, rel=0.03)
+    assert d.min() == pytest.approx(R * (1 - np.sqrt(3) / 2), rel=0.05)
+    assert uncovered_m(pts * 0.5, shape).max() == 0.0  # a sphere inside the cube is covered
+
+
+def test_mesh_shape_keeps_every_sizeable_part(tmp_path):
+    cfg = compose_cfg("dataset=primitives")
+    mesh = object_mesh(cfg.dataset, "mug")[0].mesh  # body and handle are separate parts
+    shape = collision_shape(mesh, SimConfig(cache_dir=str(tmp_path)))
+    pts, _ = trimesh.sample.sample_surface(mesh, 3000, seed=0)
+    assert np.percentile(uncovered_m(pts, shape), 90) < 2e-4

@@ -8,7 +8,8 @@ Per object and method: collision parts, their triangles, cold preparation (built
 temporary cache; wall and CPU seconds of this process, all its threads), the first scene build
 (``cook_s``: PhysX cooks the shape, an SDF for ``mesh``; once per process, not cached on disk), the collision surface
 outside the mesh (median, 90th percentile, max; mm, see :mod:`graspexp.sim.collision_accuracy`) and
-inside it (90th percentile), the physics wall time per step with the object resting on the support box
+inside it (90th percentile), how far the mesh surface lies outside the collision shape
+(``uncovered_p90_mm``: missing material, e.g. a dropped part), the physics wall time per step with the object resting on the support box
 (``rest_us``) and, median over ``--trials`` full collab trials with the gripper closing on it
 (``trial_us``). Prints one row per object, then the median and worst per method, and writes a CSV.
 Other arguments are Hydra overrides (e.g. ``sim.coacd_threshold=0.05``).
@@ -22,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import trimesh
 from omegaconf import OmegaConf
 from threadpoolctl import threadpool_limits
 
@@ -29,7 +31,7 @@ from graspexp.cli import compose_config
 from graspexp.datasets import load_object
 from graspexp.prepare import staged_objects
 from graspexp.seeding import derive_seed
-from graspexp.sim.collision_accuracy import shape_accuracy, surface_points
+from graspexp.sim.collision_accuracy import shape_accuracy, surface_points, uncovered_m
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.scene import build_scene
 from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial, trial_seed
@@ -66,6 +68,8 @@ def measure(overrides: list[str], dataset: str, name: str, trials: int, samples:
         shape = collision_shape(model.mesh, sim)
         prep_wall, prep_cpu = time.perf_counter() - t0, time.process_time() - c0
         acc = shape_accuracy(surface_points(shape, samples, rng=np.random.default_rng(0)), model.mesh)
+        mesh_pts, _ = trimesh.sample.sample_surface(model.mesh, samples // 2, seed=1)
+        gap_p90 = float(np.percentile(uncovered_m(mesh_pts, shape), 90)) * 1e3
         cook, rest = _rest_scene(shape, model.mesh, model.mass_kg, plain)
         per_step, ok = [], 0
         for i in range(trials):
@@ -86,6 +90,7 @@ def measure(overrides: list[str], dataset: str, name: str, trials: int, samples:
         "out_p90_mm": acc.outside_p90_mm,
         "out_max_mm": acc.outside_max_mm,
         "in_p90_mm": acc.inside_p90_mm,
+        "uncovered_p90_mm": gap_p90,
         "rest_us": rest,
         "trial_us": statistics.median(per_step) if per_step else float("nan"),
         "trials_ok": f"{ok}/{trials}",
@@ -127,6 +132,7 @@ def main(argv: list[str] | None = None) -> None:
                 f"{method:6s} {name:26s} parts {row['parts']:3d} prep {row['prep_wall_s']:6.1f} s "
                 f"(CPU {row['prep_cpu_s']:6.1f}) cook {row['cook_s']:.2f} s out p50 {row['out_p50_mm']:.2f} p90 {row['out_p90_mm']:.2f} "
                 f"max {row['out_max_mm']:.1f} mm, in p90 {row['in_p90_mm']:.2f} mm, "
+                f"uncovered p90 {row['uncovered_p90_mm']:.2f} mm, "
                 f"rest {row['rest_us']:.0f} us/step, trial {row['trial_us']:.0f} us/step",
                 flush=True,
             )
@@ -143,6 +149,7 @@ def main(argv: list[str] | None = None) -> None:
             "p90_median_mm": g["out_p90_mm"].median(),
             "p90_worst_mm": g["out_p90_mm"].max(),
             "over_1mm": g["out_p90_mm"].apply(lambda s: int((s > 1.0).sum())),
+            "uncovered_p90_worst_mm": g["uncovered_p90_mm"].max(),
             "parts_median": g["parts"].median(),
             "prep_cpu_total_s": g["prep_cpu_s"].sum(),
             "prep_wall_total_s": g["prep_wall_s"].sum(),

@@ -48,8 +48,11 @@ class SimConfig:
     (``python -m graspexp.bench.collision_shapes``)."""
     mesh_max_faces: int = 4000
     """``mesh``: triangles kept by quadric decimation of the repaired mesh; 4000 keeps the surface within
-    0.28 mm (p90) of the scan on every staged object ; undecimated (16k) meshes cost 1.5x per step in trials and
-    1500 faces pinch the mug's wall (p90 10 mm)."""
+    0.28 mm (p90) of the scan on every staged object; undecimated (16k) meshes cost 1.5x per step in trials,
+    and 1500 faces pinch the mug's wall (p90 10 mm)."""
+    mesh_min_part_area: float = 0.01
+    """``mesh``: connected parts with less than this fraction of the mesh's surface area are dropped as
+    scan debris (google_16k scans carry a few specks); larger parts (a modelled mug's handle) are kept."""
     sdf_spacing_m: float = 0.005
     """``mesh``: PhysX SDF grid spacing, m. PhysX simulates a dynamic triangle mesh only with an SDF, but
     computes its contacts with boxes and convex shapes (support, floor, fingers, palm) on the triangles:

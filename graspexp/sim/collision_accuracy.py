@@ -90,6 +90,22 @@ def signed_distance_m(points: np.ndarray, mesh: trimesh.Trimesh) -> np.ndarray:
     return np.where(side < 0.0, -dist, dist)
 
 
+def uncovered_m(points: np.ndarray, shape: CollisionShape) -> np.ndarray:
+    """How far each point ((n, 3), object frame, m; e.g. samples of the mesh surface) lies outside
+    ``shape``: (n,) m, 0 inside. A fingertip on such a point would sink that deep into the object.
+
+    Each closed piece (a hull, or a shell of the ``mesh`` shape) gives a signed distance by the nearest
+    face's normal; the union's is the smallest.
+    """
+    pieces = [
+        p for m in shape.meshes() for p in (m.split(only_watertight=False) if not shape.convex else [m])
+    ]
+    if shape.convex:
+        pieces = [trimesh.convex.convex_hull(np.asarray(m.vertices, dtype=np.float64)) for m in pieces]
+    d = np.min([signed_distance_m(points, piece) for piece in pieces], axis=0)
+    return np.maximum(d, 0.0)
+
+
 def shape_accuracy(surface_points: np.ndarray, mesh: trimesh.Trimesh) -> ShapeAccuracy:
     """Outside/inside distances of collision-surface samples ((n, 3), object frame, m) against ``mesh``."""
     d = signed_distance_m(surface_points, mesh) * 1e3

@@ -2,8 +2,8 @@
 
 Three methods (``sim.collision_method``):
 
-* ``mesh``: the mesh repaired to a closed, manifold surface (MeshFix; scanned meshes have holes and
-  loose bits), decimated to ``sim.mesh_max_faces`` triangles, repaired again, and collided as one PhysX
+* ``mesh``: each sizeable part of the mesh repaired to a closed, manifold surface (MeshFix; scanned
+  meshes have holes and loose bits), decimated to ``sim.mesh_max_faces`` triangles, repaired again, and collided as one PhysX
   triangle mesh with an SDF (PhysX simulates a dynamic triangle mesh only with an SDF). Supports and
   floors must then be boxes: PhysX makes no contacts between such a mesh and a plane.
 * ``coacd`` / ``vhacd``: a convex decomposition (CoACD, or V-HACD through ``vhacdx``); one convex
@@ -62,6 +62,7 @@ def shape_params(cfg: SimConfig) -> dict:
         return {
             "method": method,
             "max_faces": int(cfg.mesh_max_faces),
+            "min_part_area": float(cfg.mesh_min_part_area),
             "sdf_spacing_m": float(cfg.sdf_spacing_m),
         }
     if method == "coacd":
@@ -129,7 +130,7 @@ def _build(mesh: trimesh.Trimesh, params: dict) -> tuple[bool, list[tuple[np.nda
         return True, [_part(hull.vertices, hull.faces)]
     method = params["method"]
     if method == "mesh":
-        return False, [_closed_mesh(mesh, params["max_faces"])]
+        return False, [_closed_mesh(mesh, params["max_faces"], params["min_part_area"])]
     if method == "coacd":
         import coacd
 
@@ -151,26 +152,38 @@ def _part(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return np.asarray(vertices, dtype=np.float32), np.asarray(faces, dtype=np.int64)
 
 
-def _closed_mesh(mesh: trimesh.Trimesh, max_faces: int) -> tuple[np.ndarray, np.ndarray]:
-    """``mesh`` repaired to one closed manifold shell (its largest), decimated to at most ``max_faces``
-    triangles and repaired again (decimation can pinch edges)."""
+def _closed_mesh(
+    mesh: trimesh.Trimesh, max_faces: int, min_area_fraction: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """``mesh`` as closed manifold shells: each connected component with at least ``min_area_fraction``
+    of the mesh's area (smaller ones are scan debris) repaired by MeshFix, decimated to its share of
+    ``max_faces`` (by area) and repaired again (decimation can pinch edges); the shells in one array."""
     import pymeshfix
 
-    with _quiet_stdio():  # MeshFix prints "could not fix everything" from C for meshes it did close
-        v, f = pymeshfix.clean_from_arrays(np.asarray(mesh.vertices), np.asarray(mesh.faces, dtype=np.int32))
-        if len(f) > max_faces:
-            small = trimesh.Trimesh(v, f, process=False).simplify_quadric_decimation(face_count=max_faces)
-            v, f = pymeshfix.clean_from_arrays(
-                np.asarray(small.vertices), np.asarray(small.faces, dtype=np.int32)
+    components = mesh.split(only_watertight=False)
+    kept = [c for c in components if c.area >= min_area_fraction * mesh.area]
+    area = sum(c.area for c in kept)
+    vertices, faces, offset = [], [], 0
+    for c in kept:
+        budget = max(int(max_faces * c.area / area), 64)
+        with _quiet_stdio():  # MeshFix prints "could not fix everything" from C for shells it did close
+            v, f = pymeshfix.clean_from_arrays(np.asarray(c.vertices), np.asarray(c.faces, dtype=np.int32))
+            if len(f) > budget:
+                small = trimesh.Trimesh(v, f, process=False).simplify_quadric_decimation(face_count=budget)
+                v, f = pymeshfix.clean_from_arrays(
+                    np.asarray(small.vertices), np.asarray(small.faces, dtype=np.int32)
+                )
+        shell = trimesh.Trimesh(v, f, process=False)
+        if not shell.is_watertight or shell.volume <= 0:
+            raise ValueError(
+                "a part of the mesh could not be repaired into a closed surface for "
+                f"sim.collision_method=mesh (after MeshFix: {len(f)} faces, watertight={shell.is_watertight}); "
+                "use sim.collision_method=coacd for this object"
             )
-    closed = trimesh.Trimesh(v, f, process=False)
-    if not closed.is_watertight or closed.volume <= 0:
-        raise ValueError(
-            "the mesh could not be repaired into a closed surface for sim.collision_method=mesh "
-            f"(after MeshFix: {len(f)} faces, watertight={closed.is_watertight}); "
-            "use sim.collision_method=coacd for this object"
-        )
-    return _part(v, f)
+        vertices.append(v)
+        faces.append(f + offset)
+        offset += len(v)
+    return _part(np.concatenate(vertices), np.concatenate(faces))
 
 
 @contextmanager
