@@ -41,27 +41,27 @@ class SimConfig:
     log_rate_hz: float = 30.0
     """Sim-time rate of transforms and contacts in the MCAP log, Hz."""
     collision_method: str = "mesh"
-    """Object collision geometry: ``mesh`` (the mesh repaired to one closed surface, decimated, and
-    collided as a PhysX SDF triangle mesh), ``coacd`` or ``vhacd`` (convex decompositions). ``mesh`` is the
-    one within 1 mm of every staged object: 90th percentile of the collision surface outside the mesh
-    <= 0.28 mm on all 32, against 3.7-5.5 mm for CoACD at the settings below
-    (``python -m graspexp.bench.collision_shapes``)."""
+    """Object collision geometry: ``mesh`` (each sizeable part of the mesh repaired to a closed surface,
+    decimated, checked, and collided as a PhysX SDF triangle mesh), ``coacd`` or ``vhacd`` (convex
+    decompositions). ``mesh`` is the one within 1 mm of every staged object: 90th percentile of the
+    collision surface outside the mesh <= 0.26 mm on all 32, against 3.7-5.5 mm for CoACD at the
+    settings below (``python -m graspexp.bench.collision_shapes``)."""
     mesh_max_faces: int = 4000
-    """``mesh``: triangles first kept by quadric decimation of the repaired mesh; 4000 keeps the surface within
-    0.28 mm (p90) of the scan on every staged object; undecimated (16k) meshes cost 1.5x per step in trials,
-    and 1500 faces pinch the mug's wall (p90 10 mm)."""
+    """``mesh``: first face budget for the quadric decimation of the repaired mesh. 4000 keeps every
+    staged object but the bowl within 0.26 mm (p90) of the scan; 16k (no decimation) costs 1.5x per step
+    in trials, and 1500 pinches the mug's wall (10 mm)."""
     mesh_tolerance_m: float = 0.0005
     """``mesh``: the repaired, decimated surface is measured against the scan (90th percentile of either
     lying outside the other); over this the face budget doubles, up to no decimation, m. Half the 1 mm
-    target, because decimation can collapse a thin wall (the bowl's, at 4000 faces: 8 mm)."""
+    target: decimation can collapse a thin wall (the bowl's, at 4000 faces: 8 mm)."""
     mesh_min_part_area: float = 0.01
     """``mesh``: connected parts with less than this fraction of the mesh's surface area are dropped as
     scan debris (google_16k scans carry a few specks); larger parts (a modelled mug's handle) are kept."""
     sdf_spacing_m: float = 0.005
-    """``mesh``: PhysX SDF grid spacing, m. PhysX simulates a dynamic triangle mesh only with an SDF, but
-    computes its contacts with boxes and convex shapes (support, floor, fingers, palm) on the triangles:
-    the spacing changes the once-per-process cooking time (mug, 16k faces: 0.3 s at 4 mm, 7 s at 1 mm),
-    not the contacts (probe contacts measured identical at 1, 2 and 4 mm)."""
+    """``mesh``: PhysX SDF grid spacing, m. PhysX simulates a dynamic triangle mesh only with an SDF but
+    computes its contacts with boxes and convex shapes (support, floor, fingers, palm) on the triangles,
+    so the spacing sets only the once-per-process cooking time (mug, 16k faces: 0.3 s at 4 mm, 7 s at
+    1 mm), not the contacts (tests/test_collision_shapes.py: the same landing, bit for bit)."""
     coacd_threshold: float = 0.1
     """``coacd``: concavity threshold (CoACD's unit: a fraction of the bounding-box diagonal)."""
     coacd_preprocess_resolution: int = 30
