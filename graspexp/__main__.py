@@ -3,21 +3,25 @@
 import hydra
 from omegaconf import DictConfig
 
-from graspexp.cli import fail, run_checked
+from graspexp.cli import run_checked
 from graspexp.config import register_configs
+from graspexp.jobs import job_failed
 
 register_configs()
 
 
 @hydra.main(version_base="1.3", config_path="../conf", config_name="config")
-def _job(cfg: DictConfig) -> float:
+def _job(cfg: DictConfig) -> float | None:
     from graspexp.datasets import DatasetError
-    from graspexp.runner import run_job
+    from graspexp.runner import RunError, run_job
 
     try:
         return run_job(cfg)
-    except DatasetError as exc:
-        fail(str(exc))
+    except (DatasetError, RunError) as exc:  # this job cannot run; in a multirun, the others go on
+        job_failed(str(exc))
+    except OSError as exc:  # an input or output file: one line, not a traceback
+        job_failed(f"{exc.strerror or exc}: {exc.filename}" if exc.filename else str(exc))
+    return None
 
 
 def main() -> None:

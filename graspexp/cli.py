@@ -3,13 +3,12 @@ so a typo, a wrong type or an out-of-range value is one line on stderr and exit 
 
 import sys
 from collections.abc import Callable
-from pathlib import Path
 
 from omegaconf import DictConfig
 
 from graspexp.config import ConfigError, register_configs, validate
+from graspexp.config.registry import CONF_DIR
 
-CONF_DIR = str(Path(__file__).resolve().parent.parent / "conf")
 _VALUE_FLAGS = {
     "--cfg",
     "-c",

@@ -13,8 +13,12 @@ Layout written (what :func:`graspexp.datasets.load_object` reads)::
     <root>/.graspexp-hashes.json                 SHA-256 of every archive without a published hash
 
 Base URLs: ``--base-url``, else env ``GRASPEXP_YCB_URL`` / ``GRASPEXP_LINEMOD_URL``, else the official
-hosts. YCB publishes no checksums: the SHA-256 of an archive is recorded on its first download and
-every later download must match it. LINEMOD is checked against the published BOP SHA-256.
+hosts. YCB publishes no checksums: the SHA-256 of an archive is recorded on its first download, once the
+archive opens as a tar file (an HTML error page is refused and deleted, nothing recorded), and every
+later download must match it; to reset a recorded hash, delete its entry from the registry file.
+LINEMOD is checked against the published BOP SHA-256. One download runs per data root at a time (a
+file lock); pooch's temporary files left by a killed download are removed by the next one, and SIGTERM
+or SIGHUP during a download cleans up like Ctrl-C.
 """
 
 from __future__ import annotations
@@ -25,14 +29,18 @@ import json
 import logging
 import os
 import shutil
+import signal
 import sys
 import tarfile
+import threading
 import zipfile
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path, PurePosixPath
 from types import SimpleNamespace
 
 import pooch
+from filelock import FileLock, Timeout
 
 from graspexp.datasets.catalog import DATASETS, LINEMOD_IDS, YCB_MASS_KG, dataset_spec, resolve_root
 from graspexp.datasets.errors import DatasetError
@@ -46,6 +54,10 @@ LINEMOD_SHA256 = "cb5b5366ce620d41800c7941c2e770036c7c13c178514fa07e6a89fda5ff0e
 """Published SHA-256 of BOP ``lm/lm_models.zip``."""
 HASH_REGISTRY = ".graspexp-hashes.json"
 ARCHIVE_DIR = ".downloads"
+LOCK_NAME = ".lock"
+"""In ``ARCHIVE_DIR``: held while a download runs, so leftover temporary files are known to be stale."""
+POOCH_TMP_PREFIX = "tmp"
+"""pooch streams each download into ``tempfile.NamedTemporaryFile(dir=...)``: ``tmp*`` in ``ARCHIVE_DIR``."""
 _LINEMOD_FOLDERS = ("models", "models_eval")
 
 log = logging.getLogger(__name__)
@@ -84,35 +96,93 @@ def _write_registry(root: Path, registry: dict[str, dict[str, str]]) -> None:
     tmp.replace(path)
 
 
-def fetch(url: str, folder: Path, fname: str, sha256: str | None, *, progress: bool = True) -> Path:
+def fetch(
+    url: str,
+    folder: Path,
+    fname: str,
+    sha256: str | None,
+    *,
+    progress: bool = True,
+    reset_hint: str = "",
+) -> Path:
     """Download ``url`` to ``folder/fname`` with pooch unless a copy with the right hash is there.
 
-    ``sha256`` None accepts any content (the caller records it). A hash mismatch or an HTTP error
-    becomes one :class:`DatasetError` naming the URL.
+    ``sha256`` None accepts any content (the caller checks and records it). A hash mismatch (its message
+    ends with ``reset_hint``) or an HTTP error becomes one :class:`DatasetError` naming the URL.
     """
     pooch_log = pooch.get_logger()
     level = pooch_log.level
     pooch_log.setLevel(logging.ERROR)  # we print our own hash messages
     try:
-        path = pooch.retrieve(
-            url,
-            known_hash=f"sha256:{sha256}" if sha256 else None,
-            fname=fname,
-            path=folder,
-            downloader=pooch.HTTPDownloader(progressbar=progress),
-        )
+        with _download_guard(folder):
+            path = pooch.retrieve(
+                url,
+                known_hash=f"sha256:{sha256}" if sha256 else None,
+                fname=fname,
+                path=folder,
+                downloader=pooch.HTTPDownloader(progressbar=progress),
+            )
     except ValueError as err:
         if "hash" not in str(err).lower():
             raise
         raise DatasetError(
             f"checksum mismatch for {url}: expected SHA-256 {sha256}, the downloaded file differs "
-            f"(corrupted download or a changed file on the server); nothing was unpacked. Details: {err}"
+            f"(corrupted download or a changed file on the server); nothing was unpacked.{reset_hint} "
+            f"Details: {err}"
         ) from None
     except OSError as err:  # requests' errors derive from OSError (IOError)
         raise DatasetError(f"download of {url} failed: {err}") from None
     finally:
         pooch_log.setLevel(level)
     return Path(path)
+
+
+def _raise_signal_as_exit(signum: int, _frame: object) -> None:
+    raise SystemExit(128 + signum)
+
+
+@contextmanager
+def _download_guard(folder: Path) -> Iterator[None]:
+    """Hold the download lock of ``folder``, remove temporary files a killed download left there, and
+    turn SIGTERM / SIGHUP into SystemExit so that pooch deletes its temporary file as on Ctrl-C."""
+    folder.mkdir(parents=True, exist_ok=True)
+    lock = FileLock(folder / LOCK_NAME, timeout=0)
+    try:
+        lock.acquire()
+    except Timeout:
+        raise DatasetError(f"another download is running into {folder}; wait for it to finish") from None
+    previous = {}
+    try:
+        for stale in folder.glob(f"{POOCH_TMP_PREFIX}*"):
+            if stale.is_file():
+                stale.unlink()
+        if threading.current_thread() is threading.main_thread():  # only it may install handlers
+            for sig in (signal.SIGTERM, signal.SIGHUP):
+                previous[sig] = signal.signal(sig, _raise_signal_as_exit)
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        lock.release()
+
+
+def _check_tar(archive: Path, url: str) -> None:
+    """Raise DatasetError (and delete ``archive``) unless it opens as a tar file: a first download's hash
+    is recorded only for an archive that is one (not, say, an HTML error page served with status 200)."""
+    try:
+        with tarfile.open(archive, "r:*") as tar:
+            tar.getmembers()
+        return
+    except (tarfile.TarError, EOFError, OSError) as err:
+        head = archive.read_bytes()[:512].lstrip().lower()
+        archive.unlink()
+        what = (
+            "an HTML page (an error page?)" if head.startswith((b"<!doctype", b"<html", b"<")) else str(err)
+        )
+        raise DatasetError(
+            f"download of {url} is not a tar archive but {what}; it was deleted and no hash was recorded. "
+            "Check the URL (--base-url / $GRASPEXP_YCB_URL) and try again"
+        ) from None
 
 
 def _safe_parts(name: str, archive: Path) -> tuple[str, ...]:
@@ -160,9 +230,14 @@ def download_ycb(
         source = base_url("ycb", url) + fname
         key = f"ycb/{fname}"
         known = registry.get(key, {}).get("sha256")
-        archive = fetch(source, archives, fname, known, progress=progress)
-        digest = sha256_of(archive)
+        hint = (
+            f" If the recorded hash is the wrong one (recorded from an error page by an older version), "
+            f"delete the entry {key!r} from {root / HASH_REGISTRY} and {archives / fname}, then download again."
+        )
+        archive = fetch(source, archives, fname, known, progress=progress, reset_hint=hint)
         if known is None:
+            _check_tar(archive, source)
+            digest = sha256_of(archive)
             registry[key] = {"sha256": digest, "url": source}
             _write_registry(root, registry)
             print(f"recorded SHA-256 {digest} of {fname} in {root / HASH_REGISTRY}")

@@ -1,5 +1,6 @@
 """Config tier: every option of every group composes and validates; bad overrides are one clear line."""
 
+import dataclasses
 import subprocess
 import sys
 from pathlib import Path
@@ -7,7 +8,9 @@ from pathlib import Path
 import pytest
 
 from graspexp.cli import CONF_DIR, split_argv
-from graspexp.config import ConfigError, validate
+from graspexp.config import ConfigError, sim, validate
+from graspexp.config.constraints import accepts, describe
+from graspexp.config.validate import NOT_CONFIG, SCHEMA_CONSTRAINTS
 from tests.conftest import compose_cfg
 
 REPO = Path(__file__).resolve().parent.parent
@@ -55,12 +58,39 @@ def test_paper_defaults():
 @pytest.mark.parametrize(
     ("override", "message"),
     [
-        ("trials=0", "trials=0 is invalid: expected a positive integer"),
+        ("trials=0", "trials=0 is invalid: expected an integer in [1, 100000]"),
         (
             "gripper.min_width_m=0.2",
-            "gripper.min_width_m=0.2 is invalid: must be below gripper.max_width_m=0.11",
+            "gripper.min_width_m=0.2 is invalid: expected < gripper.max_width_m=0.11",
         ),
-        ("planner.k=0", "planner.k=0 is invalid: expected 'auto' or a positive integer"),
+        ("planner.k=0", "planner.k=0 is invalid: expected one of auto or an integer in [1, 64]"),
+        (
+            "sim.approach_speed_mps=0",
+            "sim.approach_speed_mps=0.0 is invalid: expected a number in (0, 10] m/s",
+        ),
+        ("sim.coacd_threshold=-1", "sim.coacd_threshold=-1.0 is invalid: expected a number in [0.01, 1]"),
+        ("sim.close_s=-1", "sim.close_s=-1.0 is invalid: expected a number in (0, 60] s"),
+        (
+            "gripper.finger_mass_kg=-1",
+            "gripper.finger_mass_kg=-1.0 is invalid: expected a number in (0, 10] kg",
+        ),
+        (
+            "gripper.palm_size_m=[-1,-1,-1]",
+            "gripper.palm_size_m=[-1.0, -1.0, -1.0] is invalid: expected a list of 3 values, each a number in "
+            "(0, 1] m",
+        ),
+        (
+            "gripper.grip_force_n=1e30",
+            "gripper.grip_force_n=1e+30 is invalid: expected a number in (0, 1000] N",
+        ),
+        (
+            "+sim.bar=2",
+            "sim.bar=2 is invalid: 'bar' is not a key of group 'sim'; expected one of timestep_s, .*",
+        ),
+        (
+            "mode=base_mode",
+            "mode.name has no value: mode=base_mode is the schema, not an option; expected mode= one of bin, collab",
+        ),
         (
             "planner.main_axis=diagonal",
             "planner.main_axis='diagonal' is invalid: expected one of object, area",
@@ -68,7 +98,8 @@ def test_paper_defaults():
     ],
 )
 def test_out_of_range_values_name_the_key(override, message):
-    with pytest.raises(ConfigError, match="^" + message.replace("(", r"\(").replace(")", r"\)") + "$"):
+    escaped = message.replace("(", r"\(").replace(")", r"\)").replace("[", r"\[").replace("+", r"\+")
+    with pytest.raises(ConfigError, match="^" + escaped + "$"):
         validate(compose_cfg(override))
 
 
@@ -84,7 +115,12 @@ def test_out_of_range_values_name_the_key(override, message):
             ["-m", "rot=z,q"],
             "graspexp: error: In 'config': Could not find 'rot/q'; Available options in 'rot': xyz, z",
         ),
-        (["trials=-2"], "graspexp: error: trials=-2 is invalid: expected a positive integer"),
+        (["trials=-2"], "graspexp: error: trials=-2 is invalid: expected an integer in [1, 100000]"),
+        (
+            ["+foo=1"],
+            "graspexp: error: foo=1 is invalid: 'foo' is not a key of the job config; expected one of "
+            "dataset, mode, rot, gripper, planner, cost, sim, perception, trials, seed, objects, record, progress",
+        ),
         (
             ["-m", "--cfg", "job", "mode=bin"],
             "graspexp: error: --cfg and --multirun cannot be combined: give only one of --run, --multirun, "
@@ -116,3 +152,16 @@ def test_split_argv_drops_flags_and_their_values():
         "mode=bin",
         "rot=z",
     ]
+
+
+def test_every_key_of_every_schema_has_a_constraint():
+    for schema, constraints in SCHEMA_CONSTRAINTS.items():
+        keys = {f.name for f in dataclasses.fields(schema) if not dataclasses.is_dataclass(f.type)}
+        assert keys - NOT_CONFIG == set(constraints), schema.__name__
+
+
+def test_optional_slip_threshold_accepts_null_and_positive_values_only():
+    alternatives = sim.CONSTRAINTS["slip_threshold_m"]
+    assert accepts(alternatives, None) and accepts(alternatives, 0.02)
+    assert not accepts(alternatives, 0.0) and not accepts(alternatives, float("nan"))
+    assert describe(alternatives) == "null or a number in (0, 1] m"

@@ -6,8 +6,12 @@ import functools
 import hashlib
 import io
 import json
+import signal
+import subprocess
+import sys
 import tarfile
 import threading
+import time
 import zipfile
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
@@ -211,3 +215,75 @@ def test_cli_arguments(monkeypatch, tmp_path):
             download.parse_args(bad)
     with pytest.raises(DatasetError, match="unknown object 'teapot'"):
         download.download_ycb(tmp_path, ["teapot"], url="http://127.0.0.1:9/")
+
+
+def test_html_error_page_is_refused_and_no_hash_is_recorded(server, tmp_path):
+    folder, url, _ = server
+    page = folder / f"{YCB_ID}_google_16k.tgz"
+    page.write_bytes(b"<!DOCTYPE html><html><body>503 Service Unavailable</body></html>")
+    root = tmp_path / "data"
+    with pytest.raises(
+        DatasetError, match=r"is not a tar archive but an HTML page \(an error page\?\); it was deleted"
+    ):
+        download.download_ycb(root, [YCB_ID], url=url, progress=False)
+    assert not (root / download.HASH_REGISTRY).exists()
+    assert not (root / download.ARCHIVE_DIR / page.name).exists()
+    archive = ycb_archive(folder)  # the server works again: the real archive is accepted and recorded
+    download.download_ycb(root, [YCB_ID], url=url, progress=False)
+    registry = json.loads((root / download.HASH_REGISTRY).read_text())
+    assert registry[f"ycb/{archive.name}"]["sha256"] == hashlib.sha256(archive.read_bytes()).hexdigest()
+
+
+def test_mismatch_says_how_to_reset_a_recorded_hash(server, tmp_path):
+    folder, url, _ = server
+    root = tmp_path / "data"
+    root.mkdir()
+    key = f"ycb/{YCB_ID}_google_16k.tgz"
+    (root / download.HASH_REGISTRY).write_text(json.dumps({key: {"sha256": "0" * 64, "url": "x"}}))
+    ycb_archive(folder)
+    with pytest.raises(DatasetError, match=rf"delete the entry '{key}' from {root / download.HASH_REGISTRY}"):
+        download.download_ycb(root, [YCB_ID], url=url, progress=False)
+
+
+class _StallingHandler(SimpleHTTPRequestHandler):
+    """Sends the headers of a 10 MB file and 64 kB of it, then stalls (a download to interrupt)."""
+
+    def do_GET(self):  # noqa: N802 (http.server naming)
+        self.send_response(200)
+        self.send_header("Content-Length", str(10 << 20))
+        self.end_headers()
+        self.wfile.write(b"\0" * (64 << 10))
+        self.wfile.flush()
+        time.sleep(30)
+
+    def log_message(self, *args):
+        pass
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL], ids=["term", "kill"])
+def test_interrupted_download_leaves_no_temporary_file(server, tmp_path, sig):
+    httpd = ThreadingHTTPServer(("127.0.0.1", 0), _StallingHandler)
+    httpd.daemon_threads = True
+    threading.Thread(target=httpd.serve_forever, daemon=True).start()
+    root = tmp_path / "data"
+    cmd = [sys.executable, "-m", "graspexp.download", "dataset=ycb", f"dataset.root={root}", f"objects=[{YCB_ID}]",
+           "--base-url", f"http://127.0.0.1:{httpd.server_address[1]}/", "--no-progress"]  # fmt: skip
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    archives = root / download.ARCHIVE_DIR
+    try:
+        deadline = time.monotonic() + 60
+        while not list(archives.glob("tmp*")) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert list(archives.glob("tmp*")), "the download never started"
+        proc.send_signal(sig)
+        proc.wait(timeout=30)
+    finally:
+        proc.kill()
+        httpd.shutdown()
+        httpd.server_close()
+    if sig == signal.SIGKILL:  # nothing runs on SIGKILL: the next download removes the leftover
+        assert list(archives.glob("tmp*"))
+        folder, url, _ = server
+        ycb_archive(folder)
+        download.download_ycb(root, [YCB_ID], url=url, progress=False)
+    assert not list(archives.glob("tmp*"))

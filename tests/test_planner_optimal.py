@@ -123,10 +123,12 @@ def test_k_auto_follows_the_area_length_and_the_gripper():
     pts = cylinder_cloud(rng, 1500, radius_m=0.01, height_m=0.2)  # area length ~0.2 m along z
     mask = np.ones(len(pts), dtype=bool)
     length = np.ptp(pts[:, 2])
-    expected = int(np.ceil(length / (0.5 * RG2.max_width_m)))
-    assert expected == 4
+    expected = int(np.ceil(length / (1.0 * RG2.max_width_m)))  # clusters one stroke long (default)
+    assert expected == 2
     res = plan_optimal(request(pts, mask))
     assert res.grasp.extras["K"] == expected
+    half = PlannerConfig(name="optimal", auto_k_stroke_fraction=0.5)
+    assert plan_optimal(request(pts, mask, planner=half)).grasp.extras["K"] == 4
     wide = dataclasses.replace(RG2, max_width_m=0.5)
     assert plan_optimal(request(pts, mask, gripper=wide)).grasp.extras["K"] == 1
     capped = PlannerConfig(name="optimal", m=64, k_max=2)
@@ -177,14 +179,17 @@ def test_paths_found_too_wide_are_skipped_for_the_next_cheapest():
 
 
 def test_a_band_shorter_than_its_diameter_is_closed_across_not_along_its_height():
-    # A 66 mm can whose area is a 40 mm band, main axis from the area (planner.main_axis=area): PCA puts
+    # A 66 mm can whose area is a 40 mm band, main axes from the area (main_axis = pose_axis = area): PCA puts
     # the main axis horizontal, so a horizontal
     # approach would close the fingers along the can's height (100 mm section) with a ~75 mm opening.
     # That section does not fit the r_k opening; the planner goes on to a path whose section does.
     rng = np.random.default_rng(8)
     pts = cylinder_cloud(rng, 2048, radius_m=0.033, height_m=0.10) + [0.0, 0.0, 0.1]
     mask = (pts[:, 2] > 0.13) & (pts[:, 2] < 0.17)
-    req = request(pts, mask, table_z=0.1, planner=PlannerConfig(name="optimal", main_axis="area"))
+    area_axes = PlannerConfig(
+        name="optimal", main_axis="area", pose_axis="area", cluster_radius="rms", auto_k_stroke_fraction=0.5
+    )
+    req = request(pts, mask, table_z=0.1, planner=area_axes)
     res = plan_optimal(req)
     _check_result(res, req)
     assert abs(res.details["main_axis"][2]) < 0.3

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from sklearn.neighbors import KDTree
 
-from graspexp.planning.clusters import AUTO_K_STROKE_FRACTION, choose_k, main_axis, segment
+from graspexp.planning.clusters import choose_k, main_axis, max_radii_m, segment
 from graspexp.planning.paths import above_support, approach_directions, fibonacci_sphere, sphere_points
 
 
@@ -73,15 +73,15 @@ def test_main_axis_is_the_long_direction_with_a_fixed_sign():
 def test_auto_k_rule():
     axis = np.array([0.0, 0.0, 1.0])
     line = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.12], [0.01, 0.0, 0.05]])  # L = 0.12 m along the axis
-    assert AUTO_K_STROKE_FRACTION == 0.5
-    assert choose_k("auto", 8, line, axis, 0.100) == 3  # ceil(0.12 / 0.05)
-    assert choose_k("auto", 8, line, axis, 0.300) == 1  # bigger gripper, fewer clusters
-    assert choose_k("auto", 2, line, axis, 0.010) == 2  # clamped to k_max
-    assert choose_k("auto", 8, line[:2], axis, 0.010) == 2  # never more than the area points
-    assert choose_k(5, 8, line, axis, 0.1) == 3  # explicit K, capped at n_area
-    assert choose_k(2, 8, line, axis, 0.1) == 2
+    assert choose_k("auto", 8, line, axis, 0.100, 0.5) == 3  # ceil(0.12 / 0.05)
+    assert choose_k("auto", 8, line, axis, 0.100, 1.0) == 2  # ceil(0.12 / 0.1): clusters one stroke long
+    assert choose_k("auto", 8, line, axis, 0.300, 0.5) == 1  # bigger gripper, fewer clusters
+    assert choose_k("auto", 2, line, axis, 0.010, 0.5) == 2  # clamped to k_max
+    assert choose_k("auto", 8, line[:2], axis, 0.010, 0.5) == 2  # never more than the area points
+    assert choose_k(5, 8, line, axis, 0.1, 0.5) == 3  # explicit K, capped at n_area
+    assert choose_k(2, 8, line, axis, 0.1, 0.5) == 2
     with pytest.raises(ValueError, match="planner.k=0"):
-        choose_k(0, 8, line, axis, 0.1)
+        choose_k(0, 8, line, axis, 0.1, 0.5)
 
 
 def test_segment_radii_are_rms_distances_to_the_means():
@@ -95,6 +95,11 @@ def test_segment_radii_are_rms_distances_to_the_means():
         rms = np.sqrt(np.mean(np.sum((members - c.centers_m[j]) ** 2, axis=1)))
         assert c.radii_m[j] == pytest.approx(rms, rel=1e-12)
     assert sorted(np.round(c.centers_m[:, 2], 1)) == [0.0, 0.2, 0.4]
+    far = max_radii_m(blobs, c)
+    for j in range(3):
+        members = blobs[c.labels == j]
+        assert far[j] == pytest.approx(np.linalg.norm(members - c.centers_m[j], axis=1).max(), rel=1e-12)
+        assert far[j] > c.radii_m[j]
 
 
 def test_segment_with_too_few_distinct_points_drops_empty_clusters():

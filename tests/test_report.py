@@ -127,7 +127,10 @@ def test_table1_exact_percentages_intervals_and_deltas(sweep_dir: Path) -> None:
     assert cleanser["paper_pct"] == 100.0 and cleanser["delta_pp"] == pytest.approx(-10.0)
     mug = _cell(t1, "Mug", "collab", "z")
     assert (mug["ours_pct"], mug["lo_pct"], mug["hi_pct"]) == pytest.approx((100.0, 72.2, 100.0), abs=0.05)
+    assert (cleanser["top_reason"], cleanser["top_reason_n"]) == ("no_contact", 1)
+    assert (mug["top_reason"], mug["top_reason_n"]) == ("", 0)
     xyz = _cell(t1, "Cleanser B.", "collab", "xyz")
+    assert (xyz["top_reason"], xyz["top_reason_n"]) == ("dropped", 5)
     assert (xyz["ours_pct"], xyz["lo_pct"], xyz["hi_pct"], xyz["paper_pct"]) == pytest.approx(
         (0, 0, 27.8, 90), abs=0.05
     )
@@ -146,7 +149,7 @@ def test_table1_exact_percentages_intervals_and_deltas(sweep_dir: Path) -> None:
 
     disp = display_frame(t1)
     assert list(disp.index[:9]) == list(TABLE1.labels.values())
-    assert disp.loc["Cleanser B.", "Z-Collab ours [95% CI]"] == "90 [59.6, 98.2]"
+    assert disp.loc["Cleanser B.", "Z-Collab ours [95% CI]"] == "90 [59.6, 98.2] no_contact×1"
     assert disp.loc["Cleanser B.", "Z-Collab paper"] == "100"
     assert disp.loc["Cleanser B.", "Z-Collab Δ"] == "-10"
     assert disp.loc["Mug", "Z-Collab ours [95% CI]"] == "100 [72.2, 100]"
@@ -161,7 +164,7 @@ def test_table2_lists_missing_objects_as_na(sweep_dir: Path) -> None:
     t2 = build_report(sweep_dir).tables[1]
     disp = display_frame(t2)
     assert list(disp.index[:13]) == list(TABLE2.labels.values())
-    assert disp.loc["Ape", "Z-Bin ours [95% CI]"] == "50 [23.7, 76.3]"
+    assert disp.loc["Ape", "Z-Bin ours [95% CI]"] == "50 [23.7, 76.3] collision_support×5"
     assert disp.loc["Ape", "Z-Bin Δ"] == "-40"
     assert disp.loc["Bench vise", "Z-Bin ours [95% CI]"] == "n/a"
     assert disp.loc["Bench vise", "Z-Bin paper"] == "90"

@@ -14,6 +14,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from graspexp.jobs import job_dir_name
 from graspexp.report import collect
 
 REPO = Path(__file__).resolve().parent.parent
@@ -113,3 +114,52 @@ def test_submitit_local_launcher(tmp_path: Path) -> None:
     assert list(out.glob(".submitit/*/*_log.out")), "no submitit job log"
     table = _table(out)
     assert table[["mode", "object", "trial"]].values.tolist() == [["collab", "can", 0]]
+
+
+@pytest.mark.parametrize("launcher", ["basic", "joblib"])
+def test_a_job_that_cannot_run_does_not_stop_the_sweep(tmp_path: Path, launcher: str) -> None:
+    out, empty = tmp_path / "sweep", tmp_path / "empty"
+    empty.mkdir()
+    cmd = [
+        sys.executable, "-m", "graspexp", "-m", "dataset=linemod,primitives", "objects=[can]", "trials=1", "progress=false", f"hydra.sweep.dir={out}", f"hydra/launcher={launcher}",
+    ]  # fmt: skip
+    env = {**_env(), "GRASPEXP_DATA": str(empty)}
+    proc = subprocess.run(cmd, cwd=REPO, env=env, capture_output=True, text=True, timeout=180)
+    assert proc.returncode == 1, proc.stderr[-3000:]
+    assert "Traceback" not in proc.stderr
+    bad = "dataset=linemod,objects=[can],trials=1"
+    summary = proc.stderr[proc.stderr.index("graspexp: 1 job(s) of the sweep failed:") :].splitlines()
+    assert len(summary) == 2 and summary[1].startswith(
+        f"  {bad}: mesh file for linemod object 'can' not found"
+    )
+    assert [p.relative_to(out).parts[0] for p in _logs(out)] == [bad.replace("linemod", "primitives")]
+    assert not (out / bad / "trials").exists()
+
+
+def test_long_sweep_values_get_short_unique_dir_names_and_resume(tmp_path: Path) -> None:
+    out = tmp_path / "sweep"
+    roots = [f"/{c * 300}" for c in "ab"]  # the primitives ignore the data root: any value runs
+    cmd = [
+        sys.executable, "-m", "graspexp", "-m", f"dataset.root={roots[0]},{roots[1]}", "objects=[can]", "trials=1",
+        "progress=false", f"hydra.sweep.dir={out}",
+    ]  # fmt: skip
+    _run(cmd)
+    logs = _logs(out)
+    names = sorted({p.relative_to(out).parts[0] for p in logs})
+    assert len(logs) == 2 and len(names) == 2
+    assert [n[:17] for n in names] == ["dataset.root=_aaa", "dataset.root=_bbb"]
+    assert all(len(n) <= 120 for n in names)
+    before = {p: p.stat().st_mtime_ns for p in logs}
+    _run(cmd)
+    assert {p: p.stat().st_mtime_ns for p in _logs(out)} == before
+
+
+def test_job_dir_name_is_readable_short_and_unique() -> None:
+    assert job_dir_name(["mode=bin", "rot=z", "progress=false"], ["progress"]) == "mode=bin,rot=z"
+    long = [f"objects=[{','.join(f'obj_{i:03d}' for i in range(200))}]"]
+    name = job_dir_name(long, [])
+    assert name.startswith("objects=[obj_000,obj_001,obj_00~") and len(name) <= 120
+    other = job_dir_name([long[0].replace("199", "200")], [])
+    assert other != name and len(other) == len(name)
+    many = [f"k{i}=v{i}" for i in range(60)]
+    assert len(job_dir_name(many, [])) == 120 and "/" not in job_dir_name(["dataset.root=/a/b"], [])

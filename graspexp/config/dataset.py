@@ -4,6 +4,8 @@ from dataclasses import dataclass, field
 
 from omegaconf import MISSING
 
+from graspexp.config.constraints import TEXT, Interval, Names, Options
+
 
 @dataclass
 class DatasetConfig:
@@ -19,3 +21,13 @@ class DatasetConfig:
     """Density used for the mass when the dataset publishes none (LINEMOD, primitives), kg/m^3."""
     regions: str = MISSING
     """Grasping-area spec file name under ``graspexp/datasets/regions/``."""
+
+
+CONSTRAINTS = {
+    "name": [Options(("ycb", "linemod", "primitives"))],
+    "root": [None, *TEXT],
+    "objects": [Names()],
+    "density_kg_m3": [Interval(0, 25_000, "right", "kg/m^3")],
+    "regions": TEXT,
+}
+"""Allowed values of every key (see :mod:`graspexp.config.constraints`)."""

@@ -7,6 +7,8 @@ from dataclasses import dataclass
 
 from omegaconf import MISSING
 
+from graspexp.config.constraints import TEXT, Interval, Vector
+
 
 @dataclass
 class GripperConfig:
@@ -37,3 +39,19 @@ def finger_z_range_m(g: GripperConfig) -> tuple[float, float]:
     """(z_min, z_max) of the fingers along the approach axis in the gripper frame, m: from the palm face
     (z_min, where the palm box starts and extends further back by palm_size_m[2]) to the tips (z_max)."""
     return g.tcp_from_tip_m - g.finger_length_m, g.tcp_from_tip_m
+
+
+CONSTRAINTS = {
+    "name": TEXT,
+    "max_width_m": [Interval(0, 0.5, "right", "m")],
+    "min_width_m": [Interval(0, 0.5, "left", "m")],
+    "grip_force_n": [Interval(0, 1000, "right", "N")],
+    "finger_length_m": [Interval(0, 0.5, "right", "m")],
+    "finger_width_m": [Interval(0, 0.2, "right", "m")],
+    "finger_thickness_m": [Interval(0, 0.1, "right", "m")],
+    "palm_size_m": [Vector(3, Interval(0, 1, "right", "m"))],
+    "pad_friction": [Interval(0, 5)],
+    "finger_mass_kg": [Interval(0, 10, "right", "kg")],
+    "tcp_from_tip_m": [Interval(0, 0.5, unit="m")],
+}
+"""Allowed values of every key (see :mod:`graspexp.config.constraints`)."""

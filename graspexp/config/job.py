@@ -5,6 +5,7 @@ from typing import Any
 
 from omegaconf import MISSING
 
+from graspexp.config.constraints import BOOL, Interval, Names
 from graspexp.config.dataset import DatasetConfig
 from graspexp.config.gripper import GripperConfig
 from graspexp.config.mode import ModeConfig
@@ -47,3 +48,19 @@ class JobConfig:
     """Write one MCAP log per trial."""
     progress: bool = True
     """Show a progress bar."""
+
+
+POSE_NOISE_CONSTRAINTS = {
+    "trans_mm": [Interval(0, 1000, unit="mm")],
+    "rot_deg": [Interval(0, 180, unit="deg")],
+}
+"""Allowed values of every ``perception.noise`` key (see :mod:`graspexp.config.constraints`)."""
+
+JOB_CONSTRAINTS = {
+    "trials": [Interval(1, 100_000, integer=True)],
+    "seed": [Interval(0, 2**63 - 1, integer=True)],
+    "objects": [None, Names()],
+    "record": BOOL,
+    "progress": BOOL,
+}
+"""Allowed values of the top-level keys; the groups have their own (see :mod:`graspexp.config.constraints`)."""

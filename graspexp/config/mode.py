@@ -4,6 +4,8 @@ from dataclasses import dataclass
 
 from omegaconf import MISSING
 
+from graspexp.config.constraints import BOOL, Interval, Options, Vector
+
 
 @dataclass
 class ModeConfig:
@@ -23,3 +25,16 @@ class ModeConfig:
     """Bin mode: extra lift along world +Z after the pull back, m."""
     hold_s: float = 2.0
     """Time the grasp must hold at the end, s."""
+
+
+CONSTRAINTS = {
+    "name": [Options(("collab", "bin"))],
+    "support_height_m": [Interval(0, 2, "right", "m")],
+    "support_half_size_m": [Vector(2, Interval(0, 5, "right", "m"))],
+    "support_collides_with_gripper": BOOL,
+    "remove_support_after_grasp": BOOL,
+    "pull_back_m": [Interval(0, 2, unit="m")],
+    "lift_m": [Interval(0, 2, unit="m")],
+    "hold_s": [Interval(0, 60, "right", "s")],
+}
+"""Allowed values of every key (see :mod:`graspexp.config.constraints`)."""

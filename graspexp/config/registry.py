@@ -1,5 +1,7 @@
 """Registers every schema in Hydra's ConfigStore (``base_<group>`` in each group)."""
 
+from pathlib import Path
+
 from hydra.core.config_store import ConfigStore
 
 from graspexp.config.dataset import DatasetConfig
@@ -19,6 +21,14 @@ SCHEMAS = {
     "rot": RotConfig,
     "sim": SimConfig,
 }
+
+CONF_DIR = str(Path(__file__).resolve().parent.parent.parent / "conf")
+"""The YAML config tree (``conf/<group>/<option>.yaml``)."""
+
+
+def group_options(group: str) -> list[str]:
+    """The option names of config group ``group`` (its YAML files), sorted."""
+    return sorted(p.stem for p in (Path(CONF_DIR) / group).glob("*.yaml"))
 
 
 def register_configs() -> None:

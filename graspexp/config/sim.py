@@ -2,6 +2,8 @@
 
 from dataclasses import dataclass
 
+from graspexp.config.constraints import BOOL, TEXT, Interval, Options
+
 
 @dataclass
 class SimConfig:
@@ -33,9 +35,10 @@ class SimConfig:
     """Time given to the fingers to close, s."""
     retract_speed_mps: float = 0.25
     """Bin mode pull-back speed, m/s."""
-    slip_threshold_m: float = 0.02
-    """Slip = how far the grasp point (TCP) moved over the object, in the object frame, between closing
-    and the end of the hold; above this the grasp slipped, m."""
+    slip_threshold_m: float | None = None
+    """Optional stricter success criterion, m: fail as ``slipped`` when the grasp point (TCP) moved over
+    the object (object frame) by more than this between closing and the end of the hold. None (default):
+    the paper's criterion (IV-C), success = the object is still held; the slip is recorded either way."""
     max_speed_mps: float = 20.0
     """Any body faster than this (or NaN) means the simulation blew up, m/s."""
     log_rate_hz: float = 30.0
@@ -84,3 +87,47 @@ class SimConfig:
     """Processes that prepare collision shapes in parallel on a cold cache (one object per process)."""
     cache_dir: str | None = None
     """Collision-shape cache folder; None: env GRASPEXP_CACHE, else ~/.cache/graspexp."""
+
+
+CONSTRAINTS = {
+    "timestep_s": [Interval(0, 0.02, "right", "s")],
+    "solver_position_iterations": [Interval(1, 255, integer=True)],
+    "solver_velocity_iterations": [Interval(0, 255, integer=True)],
+    "enable_tgs": BOOL,
+    "contact_offset_m": [Interval(0, 0.1, "right", "m")],
+    "rest_offset_m": [Interval(0, 0.1, "left", "m")],
+    "object_static_friction": [Interval(0, 5)],
+    "object_dynamic_friction": [Interval(0, 5)],
+    "support_friction": [Interval(0, 5)],
+    "object_angular_damping": [Interval(0, 100, unit="1/s")],
+    "settle_max_s": [Interval(0, 60, "right", "s")],
+    "settle_min_s": [Interval(0, 60, unit="s")],
+    "settle_linear_mps": [Interval(0, 1, "right", "m/s")],
+    "settle_angular_radps": [Interval(0, 10, "right", "rad/s")],
+    "max_redrops": [Interval(0, 100, integer=True)],
+    "approach_speed_mps": [Interval(0, 10, "right", "m/s")],
+    "close_s": [Interval(0, 60, "right", "s")],
+    "retract_speed_mps": [Interval(0, 10, "right", "m/s")],
+    "slip_threshold_m": [None, Interval(0, 1, "right", "m")],
+    "max_speed_mps": [Interval(0, 1000, "right", "m/s")],
+    "log_rate_hz": [Interval(0, 1000, "right", "Hz")],
+    "collision_method": [Options(("mesh", "coacd", "vhacd"))],
+    "mesh_max_faces": [Interval(64, None, integer=True)],
+    "mesh_tolerance_m": [Interval(0, 0.01, "right", "m")],
+    "mesh_min_part_area": [Interval(0, 1, "left")],
+    # cooking time grows as spacing^-3 (mug: 7 s at 1 mm); PhysX's own default is 1 cm
+    "sdf_spacing_m": [Interval(0.0005, 0.05, unit="m")],
+    # CoACD's documented ranges (threshold 0.01-1, preprocess resolution 20-100, resolution 1000-10000)
+    "coacd_threshold": [Interval(0.01, 1)],
+    "coacd_preprocess_resolution": [Interval(20, 100, integer=True)],
+    "coacd_resolution": [Interval(1000, 10_000, integer=True)],
+    "coacd_mcts_iterations": [Interval(1, 2000, integer=True)],
+    "coacd_max_convex_hull": [Options((-1,)), Interval(1, 1000, integer=True)],
+    "vhacd_max_hulls": [Interval(1, 1024, integer=True)],
+    "vhacd_resolution": [Interval(10_000, 64_000_000, integer=True)],  # V-HACD's documented range
+    "vhacd_min_volume_error_pct": [Interval(0, 100, "right", "%")],
+    "vhacd_shrinkwrap": BOOL,
+    "prepare_workers": [Interval(1, 64, integer=True)],
+    "cache_dir": [None, *TEXT],
+}
+"""Allowed values of every key (see :mod:`graspexp.config.constraints`)."""

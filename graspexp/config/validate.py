@@ -1,95 +1,100 @@
 """Checks on a composed job config that the type system cannot express.
 
-Ranges are declared as data (dotted key -> constraint), in the manner of scikit-learn's
-``_parameter_constraints``; every message names the dotted key and the bad value.
+Every key's allowed values are declared as data next to its schema (``CONSTRAINTS`` in each schema
+module, see :mod:`graspexp.config.constraints`); this module walks the composed config against the
+schemas: unknown keys (``+foo=1``), keys left without a value (``mode=base_mode``), values out of range,
+and the few relations between keys. Every message is one line naming the dotted key, the value and the
+allowed range.
 """
 
-import math
-from collections.abc import Callable
+import dataclasses
+from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
+
+from graspexp.config import dataset, gripper, job, mode, planner, rot, sim
+from graspexp.config.constraints import accepts, describe
+from graspexp.config.registry import SCHEMAS, group_options
 
 
 class ConfigError(ValueError):
     """A composed config holds a value the job cannot use."""
 
 
-def _positive(v: float) -> bool:
-    return v > 0 and math.isfinite(v)
-
-
-def _non_negative(v: float) -> bool:
-    return v >= 0 and math.isfinite(v)
-
-
-def _k_value(v: object) -> bool:
-    return v == "auto" or (isinstance(v, int) and not isinstance(v, bool) and v >= 1)
-
-
-CONSTRAINTS: dict[str, tuple[Callable[[object], bool], str]] = {
-    "dataset.name": (lambda v: v in ("ycb", "linemod", "primitives"), "one of ycb, linemod, primitives"),
-    "dataset.density_kg_m3": (_positive, "a positive number"),
-    "mode.name": (lambda v: v in ("collab", "bin"), "one of collab, bin"),
-    "mode.support_height_m": (_positive, "a positive number"),
-    "mode.hold_s": (_positive, "a positive number"),
-    "mode.pull_back_m": (_non_negative, "a non-negative number"),
-    "mode.lift_m": (_non_negative, "a non-negative number"),
-    "rot.name": (lambda v: v in ("z", "xyz"), "one of z, xyz"),
-    "rot.drop_height_m": (_non_negative, "a non-negative number"),
-    "gripper.max_width_m": (_positive, "a positive number"),
-    "gripper.min_width_m": (_non_negative, "a non-negative number"),
-    "gripper.grip_force_n": (_positive, "a positive number"),
-    "gripper.finger_length_m": (_positive, "a positive number"),
-    "gripper.finger_width_m": (_positive, "a positive number"),
-    "gripper.finger_thickness_m": (_positive, "a positive number"),
-    "gripper.pad_friction": (_non_negative, "a non-negative number"),
-    "planner.k": (_k_value, "'auto' or a positive integer"),
-    "planner.k_max": (lambda v: v >= 1, "a positive integer"),
-    "planner.m": (lambda v: v >= 1, "a positive integer"),
-    "planner.n_points": (lambda v: v >= 16, "an integer >= 16"),
-    "planner.main_axis": (lambda v: v in ("object", "area"), "one of object, area"),
-    "planner.auto_k_stroke_fraction": (_positive, "a positive number"),
-    "planner.n_candidates": (lambda v: v >= 1, "a positive integer"),
-    "planner.n_approach": (lambda v: v >= 1, "a positive integer"),
-    "planner.friction_coef": (_non_negative, "a non-negative number"),
-    "planner.approach_tilt_weight": (_non_negative, "a non-negative number"),
-    "planner.collision_margin_m": (_non_negative, "a non-negative number"),
-    "planner.width_clearance_m": (_non_negative, "a non-negative number"),
-    "planner.com_weight": (_non_negative, "a non-negative number"),
-    "planner.sphere_radius_m": (_positive, "a positive number"),
-    "planner.width_margin": (_non_negative, "a non-negative number"),
-    "sim.timestep_s": (lambda v: 0 < v <= 0.02, "a step in (0, 0.02] s"),
-    "sim.solver_position_iterations": (lambda v: v >= 1, "a positive integer"),
-    "sim.log_rate_hz": (_positive, "a positive number"),
-    "sim.max_redrops": (_non_negative, "a non-negative integer"),
-    "trials": (lambda v: v >= 1, "a positive integer"),
-    "perception.noise.trans_mm": (_non_negative, "a non-negative number"),
-    "perception.noise.rot_deg": (_non_negative, "a non-negative number"),
+SCHEMA_CONSTRAINTS: dict[type, dict[str, list]] = {
+    job.JobConfig: job.JOB_CONSTRAINTS,
+    job.PoseNoiseConfig: job.POSE_NOISE_CONSTRAINTS,
+    job.PerceptionConfig: {},
+    dataset.DatasetConfig: dataset.CONSTRAINTS,
+    gripper.GripperConfig: gripper.CONSTRAINTS,
+    mode.ModeConfig: mode.CONSTRAINTS,
+    planner.PlannerConfig: planner.PLANNER_CONSTRAINTS,
+    planner.CostConfig: planner.COST_CONSTRAINTS,
+    rot.RotConfig: rot.CONSTRAINTS,
+    sim.SimConfig: sim.CONSTRAINTS,
 }
+"""Each schema's constraints mapping (field name -> allowed alternatives)."""
+NOT_CONFIG = frozenset({"defaults"})
+"""JobConfig fields that are Hydra's composition machinery, not settings."""
+RELATIONS = (
+    ("gripper.min_width_m", "<", "gripper.max_width_m"),
+    ("sim.rest_offset_m", "<", "sim.contact_offset_m"),
+    ("sim.settle_min_s", "<=", "sim.settle_max_s"),
+)
+"""Pairs of keys whose values must keep this order."""
 
 
-def validate(cfg: DictConfig) -> None:
-    """Raise :class:`ConfigError` naming the first dotted key whose value is out of range."""
-    for key, (ok, expected) in CONSTRAINTS.items():
-        value = OmegaConf.select(cfg, key, default=None)
-        if value is None:
-            continue
-        if not ok(value):
-            raise ConfigError(f"{key}={value!r} is invalid: expected {expected}")
-    name = OmegaConf.select(cfg, "planner.name", default=None)
-    if name is not None:
-        from graspexp.planning.registry import PLANNERS
+def _fields(schema: type) -> dict[str, dataclasses.Field]:
+    return {f.name: f for f in dataclasses.fields(schema) if f.name not in NOT_CONFIG}
 
-        if name not in PLANNERS:
+
+def _check_node(node: DictConfig, schema: type, prefix: str) -> None:
+    fields = _fields(schema)
+    constraints = SCHEMA_CONSTRAINTS[schema]
+    for key in node.keys():
+        if key not in fields and key not in NOT_CONFIG:
+            value = OmegaConf.select(node, str(key), throw_on_missing=False)
+            where = f"group '{prefix[:-1]}'" if prefix else "the job config"
             raise ConfigError(
-                f"planner.name={name!r} is invalid: expected one of {', '.join(sorted(PLANNERS))}"
+                f"{prefix}{key}={value!r} is invalid: {key!r} is not a key of {where}; "
+                f"expected one of {', '.join(fields)}"
             )
-    g = cfg.get("gripper")
-    if g is not None and g.min_width_m >= g.max_width_m:
+    for name, field in fields.items():
+        dotted = prefix + name
+        if OmegaConf.is_missing(node, name):
+            _missing(dotted)
+        value = node[name]
+        if dataclasses.is_dataclass(field.type):
+            _check_node(value, field.type, dotted + ".")
+            continue
+        plain = OmegaConf.to_container(value) if OmegaConf.is_config(value) else value
+        if not accepts(constraints[name], plain):
+            raise ConfigError(f"{dotted}={plain!r} is invalid: expected {describe(constraints[name])}")
+
+
+def _missing(dotted: str) -> None:
+    group = dotted.split(".")[0]
+    if group in SCHEMAS:
         raise ConfigError(
-            f"gripper.min_width_m={g.min_width_m!r} is invalid: must be below gripper.max_width_m={g.max_width_m!r}"
+            f"{group}.{dotted.split('.', 1)[-1]} has no value: {group}=base_{group} is the schema, not an "
+            f"option; expected {group}= one of {', '.join(group_options(group))}"
         )
-    if g is not None and len(g.palm_size_m) != 3:
-        raise ConfigError(
-            f"gripper.palm_size_m={list(g.palm_size_m)!r} is invalid: expected [x, y, z] in metres"
-        )
+    raise ConfigError(f"{dotted} has no value: set it with {dotted}=...")
+
+
+def _check_relations(cfg: DictConfig) -> None:
+    for left, op, right in RELATIONS:
+        a, b = OmegaConf.select(cfg, left), OmegaConf.select(cfg, right)
+        if a is not None and b is not None and not (a < b if op == "<" else a <= b):
+            raise ConfigError(f"{left}={a!r} is invalid: expected {op} {right}={b!r}")
+
+
+def validate(cfg: DictConfig | Any) -> None:
+    """Raise :class:`ConfigError` naming the first dotted key whose value is unknown, missing or invalid."""
+    _check_node(cfg, job.JobConfig, "")
+    _check_relations(cfg)
+    from graspexp.planning.registry import PLANNERS
+
+    name = cfg.planner.name
+    if name not in PLANNERS:
+        raise ConfigError(f"planner.name={name!r} is invalid: expected one of {', '.join(sorted(PLANNERS))}")

@@ -12,6 +12,7 @@ import numpy as np
 import trimesh
 
 from graspexp.datasets.catalog import (
+    LINEMOD_IDS,
     LINEMOD_MM_TO_M,
     YCB_MASS_KG,
     check_object_name,
@@ -20,6 +21,7 @@ from graspexp.datasets.catalog import (
     resolve_root,
 )
 from graspexp.datasets.errors import DatasetError
+from graspexp.datasets.meshcheck import check_bop_info, check_file, check_geometry
 from graspexp.datasets.model import ObjectModel
 from graspexp.datasets.primitives import PRIMITIVES
 from graspexp.datasets.regions import area_mask, load_region_specs, regions_path
@@ -45,8 +47,9 @@ def load_mesh(path: Path | str, scale: float = 1.0) -> MeshEntry:
     """The validated mesh of ``path`` with coordinates multiplied by ``scale`` (file units -> metres).
 
     Cached on (resolved path, modification time, scale): repeated trials do not reload. Textures and
-    materials are never decoded. Raises :class:`DatasetError` for an unreadable file, no faces,
-    non-finite vertices or zero volume.
+    materials are never decoded. Raises :class:`DatasetError` for an unreadable file, element counts
+    that disagree with the file's header (:mod:`graspexp.datasets.meshcheck`), no faces, non-finite
+    vertices, zero volume, or a closed mesh whose volume exceeds its convex hull's.
     """
     resolved = Path(path).resolve()
     try:
@@ -58,6 +61,7 @@ def load_mesh(path: Path | str, scale: float = 1.0) -> MeshEntry:
 
 @functools.lru_cache(maxsize=MESH_CACHE_SIZE)
 def _load_mesh_cached(path: Path, _mtime_ns: int, scale: float) -> MeshEntry:
+    check_file(path)
     try:
         with warnings.catch_warnings():
             # Some google_16k OBJ files hold a `vn nan nan nan` line; vertex normals are recomputed anyway.
@@ -93,6 +97,11 @@ def _validated(mesh: trimesh.Trimesh, what: str) -> MeshEntry:
     if watertight and mesh.volume < 0:
         mesh.invert()  # inside-out winding: make face normals point outwards
     volume = float(mesh.volume) if watertight else hull_volume
+    if watertight and not 0 < volume <= hull_volume * (1 + 1e-6):
+        raise DatasetError(
+            f"broken mesh {what}: it is closed but encloses {volume:.3g} m^3 against a convex hull of "
+            f"{hull_volume:.3g} m^3 (self-intersecting or inconsistently wound faces)"
+        )
     mesh.vertices.flags.writeable = False
     mesh.faces.flags.writeable = False
     return MeshEntry(mesh=mesh, volume_m3=volume, watertight=watertight)
@@ -105,7 +114,11 @@ def object_mesh(cfg: Any, name: str) -> tuple[MeshEntry, str]:
         return _primitive_entry(name), ""
     path = mesh_path(cfg, name)
     scale = LINEMOD_MM_TO_M if cfg.name == "linemod" else 1.0
-    return load_mesh(path, scale), str(path.resolve())
+    entry = load_mesh(path, scale)
+    if cfg.name == "linemod":
+        check_bop_info(path, LINEMOD_IDS[name], entry.mesh.extents / scale)
+    check_geometry(str(path), entry.mesh.extents)
+    return entry, str(path.resolve())
 
 
 def object_mass_kg(cfg: Any, name: str, entry: MeshEntry) -> float:

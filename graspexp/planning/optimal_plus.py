@@ -79,7 +79,7 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
     for s in range(0, len(order), PATH_BATCH):
         ks, ps = np.unravel_index(order[s : s + PATH_BATCH], (k, m))
         poses = np.tile(np.eye(4), (len(ks), 1, 1))
-        poses[:, :3, :3] = grasp_rotations(directions[ks, ps], axis)
+        poses[:, :3, :3] = grasp_rotations(directions[ks, ps], cand.pose_axis)
         poses[:, :3, 3] = centers[ks]
         placed = place_for_request(req, poses, min_widths_m=openings[ks])
         examined += len(ks)

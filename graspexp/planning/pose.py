@@ -28,6 +28,7 @@ import numpy as np
 
 from graspexp.config import GripperConfig
 from graspexp.config.gripper import finger_z_range_m
+from graspexp.planning.kernels import grasp_frames, slab_spans
 
 PARALLEL_TOL = 1e-6
 """Below this norm of the Gram-Schmidt residual the main axis counts as parallel to the approach."""
@@ -36,29 +37,12 @@ PARALLEL_TOL = 1e-6
 def grasp_rotations(approaches: np.ndarray, axis: np.ndarray) -> np.ndarray:
     """(B,3,3) rotations whose columns are X, Y, Z of the grasp frame (module doc), world.
 
-    approaches : (B, 3) approach directions (normalised here); axis : (3,) unit main axis.
+    approaches : (B, 3) approach directions (normalised here); axis : (3,) unit main axis. Compiled
+    (:func:`graspexp.planning.kernels.grasp_frames`): numpy's per-call overhead on (B, 3) arrays was a
+    tenth of a plan.
     """
-    z = np.asarray(approaches, dtype=np.float64).reshape(-1, 3)
-    z = z / np.sqrt(np.einsum("ij,ij->i", z, z))[:, None]
-    a = np.asarray(axis, dtype=np.float64)
-    x = a - (z @ a)[:, None] * z
-    norm = np.sqrt(np.einsum("ij,ij->i", x, x))
-    for b in np.flatnonzero(norm < PARALLEL_TOL):
-        seed = np.zeros(3)
-        seed[int(np.argmin(np.abs(z[b])))] = 1.0
-        x[b] = seed - np.dot(seed, z[b]) * z[b]
-        norm[b] = np.linalg.norm(x[b])
-    x /= norm[:, None]
-    rot = np.empty((len(z), 3, 3))
-    rot[:, :, 0] = x
-    rot[:, :, 2] = z
-    # Y = Z x X, written out: np.cross costs ~50 us of overhead per call at these sizes.
-    y = rot[:, :, 1]
-    y[:, 0] = z[:, 1] * x[:, 2] - z[:, 2] * x[:, 1]
-    y[:, 1] = z[:, 2] * x[:, 0] - z[:, 0] * x[:, 2]
-    y[:, 2] = z[:, 0] * x[:, 1] - z[:, 1] * x[:, 0]
-    y /= np.sqrt(np.einsum("ij,ij->i", y, y))[:, None]
-    return rot
+    z = np.ascontiguousarray(approaches, dtype=np.float64).reshape(-1, 3)
+    return grasp_frames(z, np.ascontiguousarray(axis, dtype=np.float64), PARALLEL_TOL)
 
 
 def grasp_rotation(approach: np.ndarray, axis: np.ndarray) -> np.ndarray:
@@ -89,21 +73,17 @@ def slab_spans_m(
 
     Returns
     -------
-    (B, 2) float64, metres, relative to each centre ([0, 0] where no point falls in the slab).
+    (B, 2) float64, metres, relative to each centre ([0, 0] where no point falls in the slab). Compiled
+    (:func:`graspexp.planning.kernels.slab_spans`): one pass over the points per rotation.
     """
-    pts = np.asarray(points_m, dtype=np.float64)
-    rots = np.asarray(rotations, dtype=np.float64)
-    n_rot = len(rots)
-    centers = np.broadcast_to(np.asarray(centers_m, dtype=np.float64), (n_rot, 3))
-    # Row 3 b + j is axis j of rotation b; grasp-frame coordinates R^T (x - c) = R^T x - R^T c, in one
-    # (3B, 3) x (3, N) product for every path of the batch, whatever its cluster.
-    axes = rots.transpose(0, 2, 1).reshape(3 * n_rot, 3)
-    offsets = np.einsum("ij,ij->i", axes, np.repeat(centers, 3, axis=0))
-    local = (axes @ pts.T - offsets[:, None]).reshape(n_rot, 3, len(pts))
+    rots = np.ascontiguousarray(rotations, dtype=np.float64)
+    centers = np.ascontiguousarray(np.broadcast_to(np.asarray(centers_m, dtype=np.float64), (len(rots), 3)))
     z_lo, z_hi = finger_z_range_m(gripper)
-    x, y, z = local[:, 0], local[:, 1], local[:, 2]
-    inside = (np.abs(x) <= gripper.finger_width_m / 2) & (z >= z_lo) & (z <= z_hi)
-    hi = np.where(inside, y, -np.inf).max(axis=1)
-    lo = np.where(inside, y, np.inf).min(axis=1)
-    any_in = inside.any(axis=1)
-    return np.stack([np.where(any_in, lo, 0.0), np.where(any_in, hi, 0.0)], axis=1)
+    return slab_spans(
+        np.ascontiguousarray(points_m, dtype=np.float64),
+        centers,
+        rots,
+        gripper.finger_width_m / 2,
+        z_lo,
+        z_hi,
+    )

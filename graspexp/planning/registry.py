@@ -6,13 +6,14 @@ Every planner is a pure function ``PlanRequest -> PlanResult``. Add one with
 
 from collections.abc import Callable
 
+from graspexp.planning.optimal import LITERAL_NAME as OPTIMAL_LITERAL_NAME
 from graspexp.planning.optimal import NAME as OPTIMAL_NAME
 from graspexp.planning.optimal import plan_optimal
 from graspexp.planning.request import PlanRequest, PlanResult
 
 Planner = Callable[[PlanRequest], PlanResult]
 
-PLANNERS: dict[str, Planner] = {OPTIMAL_NAME: plan_optimal}
+PLANNERS: dict[str, Planner] = {OPTIMAL_NAME: plan_optimal, OPTIMAL_LITERAL_NAME: plan_optimal}
 
 
 class UnknownPlanner(KeyError):

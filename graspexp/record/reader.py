@@ -61,6 +61,8 @@ class TrialLog:
     message_count: int
     scenes: list[tuple[float, list[dict]]] = field(default_factory=list)
     """(t_s, foxglove.SceneEntity dicts) for each /scene message."""
+    scene_deletions: list[tuple[float, str]] = field(default_factory=list)
+    """(t_s, entity id) of every scene entity deleted (e.g. the collab support when it is removed)."""
 
 
 def _name(source: Any) -> str:
@@ -219,6 +221,7 @@ def read_trial(source: Path | str | IO[bytes], *, require_result: bool = True) -
                 log.result = msg
             elif ch.topic == S.TOPIC_SCENE:
                 log.scenes.append((t_s, list(msg["entities"])))
+                log.scene_deletions.extend((t_s, str(d["id"])) for d in msg.get("deletions", []))
         except (KeyError, TypeError, ValueError, IndexError) as exc:
             raise CorruptLogError(
                 f"{name}: malformed {schema_name} message on {ch.topic} at t={t_s:.6f} s ({exc!r})"

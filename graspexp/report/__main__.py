@@ -15,6 +15,9 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m graspexp.report", description=__doc__.splitlines()[0])
     parser.add_argument("dir", type=Path, help="run or multirun directory holding trials/**/*.mcap")
     parser.add_argument("--out", type=Path, default=None, help="output folder (default: DIR/report)")
+    parser.add_argument(
+        "--gallery", type=int, default=2, metavar="N", help="failures drawn per setting and reason (0: none)"
+    )
     args = parser.parse_args(argv)
     if not args.dir.is_dir():
         print(f"graspexp.report: error: {args.dir} is not a directory", file=sys.stderr)
@@ -24,7 +27,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"graspexp.report: error: no trial logs (trials/*/*.mcap) below {args.dir}", file=sys.stderr)
         return 2
     out = args.out if args.out is not None else args.dir / "report"
-    print(write_report(report, out))
+    print(write_report(report, out, gallery_per_reason=args.gallery))
     print(f"\nreport written to {out}", file=sys.stderr)
     return 0
 

@@ -6,6 +6,8 @@ Output files (in ``<dir>/report/`` unless told otherwise)::
     table<N>_<dataset>_<planner>.*   success table: .md / .tex (paper layout), .csv (numeric), .png
     failures.{md,csv,tex}            failure-reason counts per setting
     runtime.{md,csv,tex}             planner wall time p50 / p95 against the paper's 0.1 s
+    strict.csv                       success by the paper's criterion and by the stricter slip one
+    gallery.md, gallery/*.png        failure examples drawn from their logs (:mod:`.gallery`)
     unreadable.csv                   logs that could not be read (path, reason), if any
 """
 
@@ -16,12 +18,15 @@ import pandas as pd
 
 from graspexp.report.collect import Collected, collect
 from graspexp.report.figures import success_chart
+from graspexp.report.gallery import write_gallery
 from graspexp.report.paper import PLANNER_RUNTIME_S
 from graspexp.report.render import display_frame, fmt_pct, footnotes, latex, markdown
 from graspexp.report.tables import (
+    STRICT_SLIP_M,
     SuccessTable,
     failure_breakdown,
     runtime_table,
+    strict_table,
     success_tables,
     wide_numeric,
 )
@@ -33,6 +38,8 @@ class Report:
     tables: list[SuccessTable]
     failures: pd.DataFrame
     runtime: pd.DataFrame
+    strict: pd.DataFrame
+    """Success by the paper's criterion beside the stricter slip criterion, per setting."""
 
 
 def build_report(root: Path | str) -> Report:
@@ -40,8 +47,8 @@ def build_report(root: Path | str) -> Report:
     col = collect(root)
     df = col.results
     if df.empty:
-        return Report(col, [], pd.DataFrame(), pd.DataFrame())
-    return Report(col, success_tables(df), failure_breakdown(df), runtime_table(df))
+        return Report(col, [], pd.DataFrame(), pd.DataFrame(), pd.DataFrame())
+    return Report(col, success_tables(df), failure_breakdown(df), runtime_table(df), strict_table(df))
 
 
 def _runtime_display(rt: pd.DataFrame) -> pd.DataFrame:
@@ -75,8 +82,11 @@ def _unreadable_section(col: Collected) -> list[str]:
     return [*lines, ""]
 
 
-def write_report(report: Report, out_dir: Path | str) -> str:
-    """Write every file of the report into ``out_dir``; returns the Markdown of report.md."""
+def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 2) -> str:
+    """Write every file of the report into ``out_dir``; returns the Markdown of report.md.
+
+    gallery_per_reason : example failures drawn per setting and failure reason (0: no gallery).
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     col = report.collected
@@ -108,6 +118,25 @@ def write_report(report: Report, out_dir: Path | str) -> str:
             markdown(report.failures, index=False),
             "",
         ]
+    if not report.strict.empty:
+        disp = report.strict.assign(
+            held_pct=[fmt_pct(v) for v in report.strict["held_pct"]],
+            strict_pct=[fmt_pct(v) for v in report.strict["strict_pct"]],
+        ).rename(
+            columns={"held_pct": "held (paper) %", "strict_pct": f"held, slip ≤ {STRICT_SLIP_M * 1e3:g} mm %"}
+        )
+        report.strict.to_csv(out / "strict.csv", index=False)
+        md += [
+            "## Success criterion: the paper's and a stricter one",
+            "",
+            markdown(disp, index=False),
+            "",
+            "Paper IV-C: success = the object is still held after the support is removed (collab) or after "
+            "the pull back (bin); the stricter column also needs the grasp point to have slid at most "
+            f"{STRICT_SLIP_M * 1e3:g} mm over the object (each log's slip_m; `sim.slip_threshold_m` makes it "
+            "the criterion of a run).",
+            "",
+        ]
     if not report.runtime.empty:
         disp = _runtime_display(report.runtime)
         (out / "runtime.md").write_text(markdown(disp, index=False) + "\n")
@@ -120,6 +149,15 @@ def write_report(report: Report, out_dir: Path | str) -> str:
             "",
             f"Wall time of the planning phase per trial (TrialResult timings_s.plan) on this machine; the "
             f"paper (section IV-F) reports {PLANNER_RUNTIME_S:g} s for the grasping strategy on an i7-9700.",
+            "",
+        ]
+    if gallery_per_reason > 0 and not col.results.empty:
+        write_gallery(col.results, out, gallery_per_reason)
+        md += [
+            "## Failure gallery",
+            "",
+            f"[gallery.md](gallery.md): up to {gallery_per_reason} failed trials per setting and failure "
+            "reason, drawn from their logs at the close and at the end (`gallery/*.png`).",
             "",
         ]
     md += _unreadable_section(col)

@@ -52,7 +52,9 @@ def _ours(row: pd.Series) -> str:
     text = f"{fmt_pct(row['ours_pct'])} [{fmt_pct(row['lo_pct'])}, {fmt_pct(row['hi_pct'])}]"
     if row["label"] in (AVERAGE, AVERAGE_SAME):
         return text
-    return text if row["n"] == TRIALS_PER_SETTING else f"{text} (n={row['n']})"
+    if row["n"] != TRIALS_PER_SETTING:
+        text = f"{text} (n={row['n']})"
+    return f"{text} {row['top_reason']}×{row['top_reason_n']}" if row["top_reason_n"] else text
 
 
 def display_frame(table: SuccessTable) -> pd.DataFrame:
@@ -78,7 +80,8 @@ def display_frame(table: SuccessTable) -> pd.DataFrame:
 
 def footnotes(table: SuccessTable) -> list[str]:
     notes = [
-        "Success rates in %; ours: successes / trials with the Wilson 95 % score interval in brackets; "
+        "Success rates in %; ours: successes / trials with the Wilson 95 % score interval in brackets, "
+        "then the object's most frequent failure reason × its count (the gallery shows examples); "
         f"(n=...) marks a cell with other than {TRIALS_PER_SETTING} trials; n/a: no logs for that object "
         "and setting (e.g. a missing mesh).",
     ]

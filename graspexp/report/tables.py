@@ -35,7 +35,9 @@ class SuccessTable:
     """The paper table this one reproduces, None for a dataset the paper does not report."""
     cells: pd.DataFrame
     """One row per (row label, setting): object (our id, or '' for average rows), label, mode, rot, n,
-    successes, ours_pct, lo_pct, hi_pct (Wilson 95 %), paper_pct, delta_pp. n = 0 means no logs."""
+    successes, ours_pct, lo_pct, hi_pct (Wilson 95 %), top_reason / top_reason_n (the most frequent
+    failure reason and its count; ties: the reason first in alphabetical order), paper_pct, delta_pp.
+    n = 0 means no logs."""
     baselines: pd.DataFrame
     """Row label -> the paper's baseline columns (BASELINES), empty for tables without baselines."""
     rows: list[str]
@@ -55,12 +57,16 @@ def _settings_for(df: pd.DataFrame) -> list[tuple[str, str]]:
 def _cell(sub: pd.DataFrame) -> dict:
     n, k = len(sub), int(sub["success"].sum())
     lo, hi = wilson_interval(k, n)
+    reasons = sub.loc[~sub["success"], "reason"].fillna("(none)").value_counts().sort_index()
+    reasons = reasons.sort_values(ascending=False, kind="stable")
     return {
         "n": n,
         "successes": k,
         "ours_pct": 100.0 * k / n if n else math.nan,
         "lo_pct": 100.0 * lo,
         "hi_pct": 100.0 * hi,
+        "top_reason": str(reasons.index[0]) if len(reasons) else "",
+        "top_reason_n": int(reasons.iloc[0]) if len(reasons) else 0,
     }
 
 
@@ -181,6 +187,25 @@ def failure_breakdown(df: pd.DataFrame) -> pd.DataFrame:
         else out.reindex(columns=[*out.columns, *reasons, *unknown])
     )
     out = out.fillna(0).astype(int)
+    return out.sort_index(level=[0, 1]).reset_index()
+
+
+STRICT_SLIP_M = 0.02
+"""Default slip limit of the report's stricter criterion, m (the earlier default of sim.slip_threshold_m)."""
+
+
+def strict_table(df: pd.DataFrame, slip_m: float = STRICT_SLIP_M) -> pd.DataFrame:
+    """Per setting (dataset, planner, mode, rot): success % by the paper's criterion (still held) and by
+    the stricter one that also needs the logged slip (``slip_m`` of each trial, m) to be at most ``slip_m``."""
+    keys = ["dataset", "planner", "mode", "rot"]
+    slip = pd.to_numeric(df["slip_m"], errors="coerce") if "slip_m" in df else pd.Series(math.nan, df.index)
+    strict = df["success"] & (slip <= slip_m)
+    out = (
+        df.assign(strict=strict)
+        .groupby(keys, sort=False)
+        .agg(trials=("success", "size"), held_pct=("success", "mean"), strict_pct=("strict", "mean"))
+    )
+    out[["held_pct", "strict_pct"]] *= 100.0
     return out.sort_index(level=[0, 1]).reset_index()
 
 

@@ -37,7 +37,14 @@ FINGER_STIFFNESS, FINGER_DAMPING = 2.0e3, 1.0e2
 COUPLING_STIFFNESS, COUPLING_DAMPING = 1.0e5, 1.0e3
 """Fixed tendon that keeps both fingers at the same opening (N/m, N s/m)."""
 CLOSE_PAST_M = 0.02
-"""Finger target beyond fully closed, so the drive saturates at the grip force."""
+"""How far past fully closed (q = 0) a finger may travel, m: its joint's lower limit is -CLOSE_PAST_M, so
+the limit never takes part of the squeeze on a thin object (with the limit at 0, a 10 mm box got 88 of
+100 N even with the target far past it)."""
+CLOSE_FORCE_MARGIN = 2.0
+"""The finger target lies this many times grip_force_n / FINGER_STIFFNESS past closed (at least
+CLOSE_PAST_M), so the drive's spring force at any contact is >= 2 x grip_force_n and the force limit alone
+sets the squeeze. PhysX's implicit drive delivers less than its limit when the spring barely exceeds it
+(measured on a 10 mm box, Robotiq 100 N: margin 1.1 -> 94 N, 1.5 -> 99.5 N, 2 -> 100 N)."""
 
 
 @dataclass
@@ -46,6 +53,8 @@ class Gripper:
     palm: sapien.physx.PhysxArticulationLinkComponent
     fingers: tuple[sapien.physx.PhysxArticulationLinkComponent, sapien.physx.PhysxArticulationLinkComponent]
     joints: list
+    close_target_m: float
+    """Finger joint target when closing (negative: past fully closed), m; see :data:`CLOSE_FORCE_MARGIN`."""
 
     def set_state(self, offset: np.ndarray, half_width_m: float) -> None:
         """Teleport to TCP offset (3,) in the grasp frame, fingers at ``half_width_m``; zero velocity."""
@@ -66,7 +75,7 @@ class Gripper:
 
     def close(self) -> None:
         """Drive the fingers past closed: each presses with the configured grip force."""
-        self.drive_fingers(-CLOSE_PAST_M)
+        self.drive_fingers(self.close_target_m)
 
     def tcp_pose(self) -> np.ndarray:
         """(4,4) world pose of the TCP (palm link frame)."""
@@ -109,7 +118,9 @@ def build_gripper(
         f.set_name(name)
         f.set_joint_name(name)
         q = _AXIS_Q[axis]
-        f.set_joint_properties("prismatic", [[0.0, cfg.max_width_m / 2]], sapien.Pose(q=q), sapien.Pose(q=q))
+        f.set_joint_properties(
+            "prismatic", [[-CLOSE_PAST_M, cfg.max_width_m / 2]], sapien.Pose(q=q), sapien.Pose(q=q)
+        )
         t = float(cfg.finger_thickness_m)
         center = [0.0, sign * t / 2, root_z + L / 2]
         f.add_box_collision(
@@ -150,4 +161,5 @@ def build_gripper(
         palm=links[PALM_NAME],
         fingers=(links["finger_left"], links["finger_right"]),
         joints=joints,
+        close_target_m=-max(CLOSE_PAST_M, CLOSE_FORCE_MARGIN * float(cfg.grip_force_n) / FINGER_STIFFNESS),
     )

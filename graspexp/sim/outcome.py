@@ -14,9 +14,10 @@ class FailureReason(str, enum.Enum):
     NO_CONTACT = "no_contact"
     """After closing, not both fingers touch the object."""
     SLIPPED = "slipped"
-    """The object moved in the palm frame by more than the slip threshold."""
+    """Held, but the grasp point slid over the object by more than ``sim.slip_threshold_m`` (only when
+    that stricter criterion is set)."""
     DROPPED = "dropped"
-    """The object left the fingers."""
+    """After the hold, not both fingers press on the object: it is no longer held (paper IV-C)."""
     SIM_UNSTABLE = "sim_unstable"
     """NaN or exploding velocities."""
     FELL_OFF_SUPPORT = "fell_off_support"

@@ -1,0 +1,132 @@
+"""Is a mesh file whole? Checks against what the file itself declares and what its dataset publishes.
+
+- OBJ: the element counts some exporters write in the header (``# Vertices: N`` / ``# Faces: N``, e.g.
+  the Katamari encoder of the YCB google_16k meshes) against the ``v`` and ``f`` lines present.
+- PLY: the header's ``element`` counts against the body (ASCII: one line per element; binary: the bytes
+  the fixed-size elements need at least).
+- BOP (LINEMOD): ``models_info.json`` beside the models publishes each model's size; the loaded extents
+  must match it.
+- Any dataset mesh: a sane size (:data:`MIN_EXTENT_M` ... :data:`MAX_EXTENT_M`). (The loader also
+  requires a closed mesh to enclose a positive volume no larger than its convex hull's.) No dataset here
+  publishes volumes or watertightness, so those are checked for consistency only.
+
+Every failure is one :class:`DatasetError` naming the file and what is wrong with it.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+
+from graspexp.datasets.errors import DatasetError
+
+MIN_EXTENT_M, MAX_EXTENT_M = 0.005, 1.0
+"""A graspable object's largest extent lies in this range, m (outside: wrong units or a broken file)."""
+BOP_SIZE_TOLERANCE = 0.01
+"""Relative tolerance of a BOP model's extents against ``models_info.json`` (plus 0.5 mm)."""
+_OBJ_HEADER = re.compile(rb"^#\s*(vertices|faces)\s*:\s*(\d+)\s*$", re.IGNORECASE | re.MULTILINE)
+_PLY_SIZES = {"char": 1, "uchar": 1, "int8": 1, "uint8": 1, "short": 2, "ushort": 2, "int16": 2, "uint16": 2,
+              "int": 4, "uint": 4, "int32": 4, "uint32": 4, "float": 4, "float32": 4, "double": 8, "float64": 8}  # fmt: skip
+
+
+def _damaged(path: Path, what: str) -> DatasetError:
+    return DatasetError(f"broken mesh {path}: {what} (a cut or damaged file?); download it again")
+
+
+def obj_counts(data: bytes) -> tuple[int, int]:
+    """(vertex lines, face lines) of an OBJ file's bytes."""
+    lines = data.split(b"\n")
+    return sum(ln.startswith(b"v ") for ln in lines), sum(ln.startswith(b"f ") for ln in lines)
+
+
+def check_obj(path: Path, data: bytes) -> None:
+    """Raise DatasetError if the OBJ's header counts disagree with its lines."""
+    n_v, n_f = obj_counts(data)
+    head = data[:4096]
+    declared = {m.group(1).lower().decode(): int(m.group(2)) for m in _OBJ_HEADER.finditer(head)}
+    if "vertices" in declared and declared["vertices"] != n_v:
+        raise _damaged(path, f"its header declares {declared['vertices']} vertices, the file holds {n_v}")
+    if "faces" in declared and declared["faces"] != n_f:
+        raise _damaged(path, f"its header declares {declared['faces']} faces, the file holds {n_f}")
+
+
+def check_ply(path: Path, data: bytes) -> None:
+    """Raise DatasetError if the PLY body is shorter than its header's element counts say."""
+    end = data.find(b"end_header")
+    if not data.startswith(b"ply") or end < 0:
+        raise _damaged(path, "no complete PLY header")
+    header = data[:end].decode("ascii", "replace").splitlines()
+    body = data[data.index(b"\n", end) + 1 :] if b"\n" in data[end:] else b""
+    fmt = next((ln.split()[1] for ln in header if ln.startswith("format ")), "ascii")
+    elements: list[tuple[str, int, int, bool]] = []  # name, count, fixed bytes per element, has a list
+    for ln in header:
+        parts = ln.split()
+        if parts[:1] == ["element"] and len(parts) == 3:
+            elements.append((parts[1], int(parts[2]), 0, False))
+        elif parts[:1] == ["property"] and elements:
+            name, count, size, has_list = elements[-1]
+            if parts[1] == "list":  # count type, then at least 3 indices for a face
+                size += _PLY_SIZES.get(parts[2], 1) + 3 * _PLY_SIZES.get(parts[3], 4)
+                has_list = True
+            else:
+                size += _PLY_SIZES.get(parts[1], 4)
+            elements[-1] = (name, count, size, has_list)
+    if fmt == "ascii":
+        rows = sum(1 for ln in body.split(b"\n") if ln.strip())
+        needed = sum(count for _, count, _, _ in elements)
+        if rows < needed:
+            counts = ", ".join(f"{count} {name}" for name, count, _, _ in elements)
+            raise _damaged(path, f"its header declares {counts} ({needed} rows), the file holds {rows} rows")
+    else:
+        needed = sum(count * size for _, count, size, _ in elements)
+        if len(body) < needed:
+            counts = ", ".join(f"{count} {name}" for name, count, _, _ in elements)
+            raise _damaged(
+                path, f"its header declares {counts}, which need {needed} bytes; the file holds {len(body)}"
+            )
+
+
+def check_file(path: Path) -> None:
+    """The declared-count checks of :func:`check_obj` / :func:`check_ply` for ``path`` (other formats: none)."""
+    try:
+        data = path.read_bytes()
+    except OSError as err:
+        raise DatasetError(f"cannot read mesh file {path}: {err.strerror}") from None
+    suffix = path.suffix.lower()
+    if suffix == ".obj":
+        check_obj(path, data)
+    elif suffix == ".ply":
+        check_ply(path, data)
+
+
+def check_geometry(what: str, extents_m: np.ndarray) -> None:
+    """Raise DatasetError unless the largest extent is a graspable object's size."""
+    size = float(np.max(extents_m))
+    if not MIN_EXTENT_M <= size <= MAX_EXTENT_M:
+        raise DatasetError(
+            f"broken mesh {what}: largest extent {size:.4g} m is outside [{MIN_EXTENT_M}, {MAX_EXTENT_M}] m "
+            "(wrong units, e.g. millimetres read as metres, or a broken file)"
+        )
+
+
+def check_bop_info(path: Path, model_id: int, extents_file_units: np.ndarray) -> None:
+    """Compare a BOP model's extents (file units, mm) with ``models_info.json`` beside it, when it lists the id."""
+    info_path = path.parent / "models_info.json"
+    if not info_path.is_file():
+        return
+    try:
+        info = json.loads(info_path.read_text()).get(str(model_id))
+    except (OSError, json.JSONDecodeError, AttributeError) as err:
+        raise DatasetError(f"cannot read {info_path}: {err}") from None
+    if not info or not all(k in info for k in ("size_x", "size_y", "size_z")):
+        return
+    published = np.array([info["size_x"], info["size_y"], info["size_z"]], dtype=float)
+    if np.any(np.abs(extents_file_units - published) > 0.5 + BOP_SIZE_TOLERANCE * published):
+        raise _damaged(
+            path,
+            f"its extents {np.round(extents_file_units, 2).tolist()} differ from the published size "
+            f"{published.round(2).tolist()} in {info_path.name}",
+        )

@@ -1,0 +1,285 @@
+"""Compiled (numba) loops of the planner: Eq. (1)'s distance sums, K-means, grasp frames, the section between
+the pads.
+
+Each kernel is a plain serial loop (no threads: on a shared 2-core machine ``prange`` was 20x slower) that
+numba compiles on first use and caches on disk, so a process pays the compilation once per machine and
+afterwards only numba's import and the cache load (README, "Development"). The cache lives in
+``$NUMBA_CACHE_DIR`` when set, else in ``numba/`` under the graspexp cache folder (``$GRASPEXP_CACHE``, else
+``~/.cache/graspexp``), never beside the installed package, which may be read-only. When no writable folder
+is found the kernels still work, compiled afresh in every process.
+
+The public wrappers live with their meaning: :func:`graspexp.planning.cost.all_path_costs` and
+:func:`~graspexp.planning.cost.distance_term`, :func:`graspexp.planning.clusters.segment` and
+:func:`~graspexp.planning.clusters.max_radii_m`, :func:`graspexp.planning.pose.grasp_rotations` and
+:func:`~graspexp.planning.pose.slab_spans_m`.
+"""
+
+import os
+import tempfile
+from pathlib import Path
+
+import numba
+import numpy as np
+
+
+def graspexp_cache_dir() -> Path:
+    """graspexp's cache folder: ``$GRASPEXP_CACHE``, else ``~/.cache/graspexp``."""
+    return Path(os.environ.get("GRASPEXP_CACHE") or Path.home() / ".cache" / "graspexp")
+
+
+def _writable(folder: Path) -> bool:
+    """True when ``folder`` exists (created here if needed) and a file can be written in it."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        tempfile.TemporaryFile(dir=folder).close()
+    except OSError:
+        return False
+    return True
+
+
+def _enable_disk_cache() -> bool:
+    """Point numba's cache at a writable folder (module doc); False when there is none."""
+    if not numba.config.CACHE_DIR:  # $NUMBA_CACHE_DIR wins when the user set it
+        numba.config.CACHE_DIR = str(graspexp_cache_dir() / "numba")
+    return _writable(Path(numba.config.CACHE_DIR))
+
+
+_CACHE = _enable_disk_cache()
+_jit = numba.njit(cache=_CACHE, nogil=True, error_model="numpy", boundscheck=False)
+_jit_fast = numba.njit(cache=_CACHE, nogil=True, error_model="numpy", boundscheck=False, fastmath=True)
+
+
+@_jit_fast
+def distance_sums(
+    points: np.ndarray,
+    centers: np.ndarray,
+    scale: float,
+    radii_mm: np.ndarray,
+    directions: np.ndarray,
+    feasible: np.ndarray,
+    numerator_mm2: float,
+    offset_mm2: float,
+    cap: float,
+) -> np.ndarray:
+    """``sum_i min(cap, num / ((Y_ip - r_k)^2 + off))`` for every feasible path of every cluster, float32
+    arithmetic (see :mod:`.cost`).
+
+    points : (N, 3) float64 and centers : (K, 3) float64 in one unit, ``scale`` x which gives mm;
+    radii_mm : (K,) r_k, mm; directions : (K, M, 3) float64 unit; feasible : (K, M) bool.
+    Returns (K, M) float64, 0 where not feasible. Requires finite inputs and ``offset_mm2 > 0``
+    (fastmath assumes no inf/NaN). Per cluster the points are copied once, relative to its centre, into
+    float32 structure-of-arrays form (x, y, z, |x|^2) so that the inner loop over points vectorises.
+    """
+    n = points.shape[0]
+    n_clusters, n_paths = feasible.shape
+    xs = np.empty(n, np.float32)
+    ys = np.empty(n, np.float32)
+    zs = np.empty(n, np.float32)
+    sq = np.empty(n, np.float32)
+    num = np.float32(numerator_mm2)
+    off = np.float32(offset_mm2)
+    top = np.float32(cap)
+    out = np.zeros((n_clusters, n_paths))
+    for k in range(n_clusters):
+        for i in range(n):
+            a = np.float32((points[i, 0] - centers[k, 0]) * scale)
+            b = np.float32((points[i, 1] - centers[k, 1]) * scale)
+            c = np.float32((points[i, 2] - centers[k, 2]) * scale)
+            xs[i] = a
+            ys[i] = b
+            zs[i] = c
+            sq[i] = a * a + b * b + c * c
+        r = np.float32(radii_mm[k])
+        for p in range(n_paths):
+            if not feasible[k, p]:
+                continue
+            dx = np.float32(directions[k, p, 0])
+            dy = np.float32(directions[k, p, 1])
+            dz = np.float32(directions[k, p, 2])
+            total = np.float32(0.0)
+            for i in range(n):
+                t = xs[i] * dx + ys[i] * dy + zs[i] * dz
+                u = np.sqrt(np.abs(sq[i] - t * t)) - r  # Y_ip - r_k; abs() absorbs rounding below 0
+                total += min(top, num / (u * u + off))
+            out[k, p] = total
+    return out
+
+
+@_jit
+def grasp_frames(approaches: np.ndarray, axis: np.ndarray, parallel_tol: float) -> np.ndarray:
+    """(B, 3, 3) grasp rotations, columns X, Y, Z (:func:`graspexp.planning.pose.grasp_rotations`).
+
+    approaches : (B, 3) float64, any length; axis : (3,) float64 unit main axis.
+    """
+    out = np.empty((approaches.shape[0], 3, 3))
+    for b in range(approaches.shape[0]):
+        z = approaches[b] / np.sqrt(approaches[b, 0] ** 2 + approaches[b, 1] ** 2 + approaches[b, 2] ** 2)
+        x = axis - (z[0] * axis[0] + z[1] * axis[1] + z[2] * axis[2]) * z
+        norm = np.sqrt(x[0] ** 2 + x[1] ** 2 + x[2] ** 2)
+        if norm < parallel_tol:  # seed with the world axis least aligned with Z (lowest index on ties)
+            seed = np.zeros(3)
+            seed[np.argmin(np.abs(z))] = 1.0
+            x = seed - (seed[0] * z[0] + seed[1] * z[1] + seed[2] * z[2]) * z
+            norm = np.sqrt(x[0] ** 2 + x[1] ** 2 + x[2] ** 2)
+        x = x / norm
+        y = np.array([z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]])
+        y = y / np.sqrt(y[0] ** 2 + y[1] ** 2 + y[2] ** 2)
+        out[b, :, 0] = x
+        out[b, :, 1] = y
+        out[b, :, 2] = z
+    return out
+
+
+@_jit_fast
+def kmeans(
+    points: np.ndarray, k: int, first: int, draws: np.ndarray, tol: float, max_iter: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Greedy k-means++ seeding, then Lloyd iterations (:func:`graspexp.planning.clusters.segment`).
+
+    points : (n, 3) float64; first : index of the first centre; draws : (k - 1, n_trials) uniform [0, 1)
+    numbers, row j - 1 picking the candidates of centre j; tol : relative tolerance (x the mean per-axis
+    variance) on the summed squared centre moves of one iteration.
+
+    Returns the (n,) int64 labels of the final centres (nearest, lowest index on ties) and the (k, 5)
+    per-cluster sums of ``[x, y, z, 1, |p|^2]`` over those labels (column 3 counts the points).
+    Requires finite points (fastmath).
+    """
+    n = points.shape[0]
+    xs = np.ascontiguousarray(points[:, 0])
+    ys = np.ascontiguousarray(points[:, 1])
+    zs = np.ascontiguousarray(points[:, 2])
+    centers = np.empty((k, 3))
+    centers[0] = points[first]
+    closest = _sq_dists(xs, ys, zs, points[first, 0], points[first, 1], points[first, 2])
+    cum = np.empty(n)
+    for j in range(1, k):
+        total = 0.0
+        for i in range(n):  # sequential on purpose: the cumulative sums the draws are searched in
+            total += closest[i]
+            cum[i] = total
+        best_potential = np.inf
+        best = closest
+        best_index = 0
+        for t in range(draws.shape[1]):
+            cand = min(np.searchsorted(cum, draws[j - 1, t] * total), n - 1)
+            trial = np.minimum(_sq_dists(xs, ys, zs, xs[cand], ys[cand], zs[cand]), closest)
+            potential = trial.sum()
+            if potential < best_potential:
+                best_potential, best_index, best = potential, cand, trial
+        closest = best
+        centers[j] = points[best_index]
+
+    spread = 0.0  # n x the summed per-axis variances
+    for values in (xs, ys, zs):
+        spread += ((values - values.mean()) ** 2).sum()
+    tol_abs = tol * spread / (3 * n)
+    labels = np.empty(n, np.int64)
+    sums = np.empty((k, 5))
+    for _ in range(max_iter):
+        _assign(xs, ys, zs, centers, labels, sums)
+        step = 0.0
+        for j in range(k):
+            if sums[j, 3] > 0:  # an empty cluster keeps its centre
+                for a in range(3):
+                    new = sums[j, a] / sums[j, 3]
+                    step += (new - centers[j, a]) ** 2
+                    centers[j, a] = new
+        if step <= tol_abs:
+            break
+    _assign(xs, ys, zs, centers, labels, sums)
+    return labels, sums
+
+
+@_jit
+def cluster_max_distances(points: np.ndarray, centers: np.ndarray, labels: np.ndarray) -> np.ndarray:
+    """(K,) largest distance of the (n, 3) points from their cluster's centre (``labels`` (n,) int64 index
+    the (K, 3) centres); 0 for a cluster without points."""
+    out = np.zeros(centers.shape[0])
+    for i in range(points.shape[0]):
+        j = labels[i]
+        d2 = (points[i, 0] - centers[j, 0]) ** 2 + (points[i, 1] - centers[j, 1]) ** 2
+        d2 += (points[i, 2] - centers[j, 2]) ** 2
+        if d2 > out[j]:
+            out[j] = d2
+    return np.sqrt(out)
+
+
+@_jit_fast
+def _sq_dists(xs: np.ndarray, ys: np.ndarray, zs: np.ndarray, cx: float, cy: float, cz: float) -> np.ndarray:
+    """(n,) squared distances of the points (coordinate arrays) from the point (cx, cy, cz)."""
+    return (xs - cx) ** 2 + (ys - cy) ** 2 + (zs - cz) ** 2
+
+
+@_jit_fast
+def _assign(
+    xs: np.ndarray, ys: np.ndarray, zs: np.ndarray, centers: np.ndarray, labels: np.ndarray, sums: np.ndarray
+) -> None:
+    """Label every point with its nearest centre (lowest index on ties) and fill the (k, 5) per-cluster
+    sums of ``[x, y, z, 1, |p|^2]``: one branch-free pass over the points per cluster to label, one to sum."""
+    k = centers.shape[0]
+    nearest = _sq_dists(xs, ys, zs, centers[0, 0], centers[0, 1], centers[0, 2])
+    labels[:] = 0
+    for j in range(1, k):  # branch-free and vectorised over the points: labels are spatially mixed
+        cx, cy, cz = centers[j, 0], centers[j, 1], centers[j, 2]
+        for i in range(xs.shape[0]):
+            d = (xs[i] - cx) ** 2 + (ys[i] - cy) ** 2 + (zs[i] - cz) ** 2
+            closer = d < nearest[i]
+            nearest[i] = d if closer else nearest[i]
+            labels[i] = j if closer else labels[i]
+    for j in range(k):
+        sx = sy = sz = count = sq = 0.0
+        for i in range(xs.shape[0]):
+            w = 1.0 if labels[i] == j else 0.0
+            x, y, z = xs[i], ys[i], zs[i]
+            sx += w * x
+            sy += w * y
+            sz += w * z
+            count += w
+            sq += w * (x * x + y * y + z * z)
+        sums[j, 0], sums[j, 1], sums[j, 2], sums[j, 3], sums[j, 4] = sx, sy, sz, count, sq
+
+
+@_jit_fast
+def slab_spans(
+    points: np.ndarray,
+    centers: np.ndarray,
+    rotations: np.ndarray,
+    half_width: float,
+    z_lo: float,
+    z_hi: float,
+) -> np.ndarray:
+    """Span [y_lo, y_hi] of the points with ``|x| <= half_width`` and ``z_lo <= z <= z_hi`` in each frame.
+
+    points : (N, 3) float64 world; centers : (B, 3) frame origins; rotations : (B, 3, 3) frame axes as
+    columns. Returns (B, 2) float64 relative to each origin, [0, 0] where no point qualifies
+    (:func:`graspexp.planning.pose.slab_spans_m`). Requires finite inputs (fastmath).
+    """
+    xs = np.ascontiguousarray(points[:, 0])  # structure of arrays: the first pass vectorises
+    ys = np.ascontiguousarray(points[:, 1])
+    zs = np.ascontiguousarray(points[:, 2])
+    n = xs.shape[0]
+    out = np.zeros((rotations.shape[0], 2))
+    big = 1e30  # a finite sentinel: fastmath assumes no inf
+    y_lo = np.empty(n)  # y where inside, else +big
+    y_hi = np.empty(n)  # y where inside, else -big
+    for b in range(rotations.shape[0]):
+        r = rotations[b]
+        cx, cy, cz = centers[b, 0], centers[b, 1], centers[b, 2]
+        for i in range(n):
+            px, py, pz = xs[i] - cx, ys[i] - cy, zs[i] - cz
+            x = r[0, 0] * px + r[1, 0] * py + r[2, 0] * pz
+            y = r[0, 1] * px + r[1, 1] * py + r[2, 1] * pz
+            z = r[0, 2] * px + r[1, 2] * py + r[2, 2] * pz
+            inside = (abs(x) <= half_width) & (z >= z_lo) & (z <= z_hi)  # no short circuit: selects
+            y_lo[i] = y if inside else big
+            y_hi[i] = y if inside else -big
+        # A second, scalar pass: LLVM does not vectorise float min/max reductions without function-wide
+        # no-NaN attributes, which numba does not set; fused into the first pass they halve its speed.
+        lo, hi = big, -big
+        for i in range(n):
+            lo = y_lo[i] if y_lo[i] < lo else lo
+            hi = y_hi[i] if y_hi[i] > hi else hi
+        if lo <= hi:  # some point was inside
+            out[b, 0] = lo
+            out[b, 1] = hi
+    return out

@@ -1,0 +1,138 @@
+"""``python -m graspexp.readings [OUT] [--only a,b] [--trials N] [--datasets ycb,linemod] [--report-only]``.
+
+Runs every reading of the paper (:data:`READINGS`: the literal one, this project's default, and each
+single change from the default) and every other planner (:data:`PLANNERS`, for a ceiling) through the
+paper's four settings on Table 1 (YCB) and Table 2 (LINEMOD), each into its own sweep directory
+``OUT/<name>/`` (default OUT: ``outputs/readings``), then writes the readings table
+(:mod:`graspexp.report.readings`) to ``OUT/readings.md`` / ``.csv`` and prints it. Every sweep is a
+Hydra multirun with the joblib launcher, resumable: running the command again skips finished trials.
+A reading is one directory and one config, so no table row mixes configs.
+"""
+
+import argparse
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from graspexp.report.readings import readings_report
+
+SETTINGS_SWEEP = ("mode=collab,bin", "rot=z,xyz")
+"""The paper's four settings (IV-C, IV-D)."""
+
+
+@dataclass(frozen=True)
+class Reading:
+    """One way to read the paper (or another planner): a name, Hydra overrides and what it changes."""
+
+    name: str
+    overrides: tuple[str, ...]
+    what: str
+
+
+READINGS: tuple[Reading, ...] = (
+    Reading("default", ("planner=optimal",), "this project's reading (conf/planner/optimal.yaml)"),
+    Reading(
+        "literal", ("planner=optimal_literal",), "the paper as printed (conf/planner/optimal_literal.yaml)"
+    ),
+    Reading(
+        "k_half_stroke",
+        ("planner=optimal", "planner.auto_k_stroke_fraction=0.5"),
+        "K = ceil(L / (0.5 stroke)): clusters half a stroke long",
+    ),
+    Reading("k_1", ("planner=optimal", "planner.k=1"), "K = 1: one cluster, the whole area"),
+    Reading("r_rms", ("planner=optimal", "planner.cluster_radius=rms"), "r_k = RMS distance from c_k"),
+    Reading(
+        "grasp_at_c_k", ("planner=optimal", "planner.grasp_point=centre"), "grasp point at c_k, no shift"
+    ),
+    Reading(
+        "no_section_fit", ("planner=optimal", "planner.section_fit=false"), "least cost wins, no section test"
+    ),
+    Reading("no_margin", ("planner=optimal", "planner.width_margin=0"), "opening = 2 r_k exactly"),
+    Reading(
+        "pose_axis_area", ("planner=optimal", "planner.pose_axis=area"), "grasp X = the area's main axis"
+    ),
+    Reading(
+        "alpha_axis_area", ("planner=optimal", "planner.main_axis=area"), "alpha and K from the area's axis"
+    ),
+    Reading(
+        "tcp_25mm",
+        ("planner=optimal", "gripper.tcp_from_tip_m=0.025"),
+        "grasp point 25 mm behind the fingertips",
+    ),
+)
+"""The readings table's rows: the literal reading, the default, and each single change from the default."""
+
+PLANNERS: tuple[Reading, ...] = (
+    Reading("optimal_plus", ("planner=optimal_plus",), "the paper's candidates with collision checks"),
+    Reading("antipodal", ("planner=antipodal",), "GPD-style antipodal sampling, whole object"),
+    Reading(
+        "antipodal_area",
+        ("planner=antipodal", "planner.sample_area_only=true"),
+        "antipodal sampling inside the grasping area",
+    ),
+    Reading("obb", ("planner=obb",), "top-down across the bounding box's short side"),
+)
+"""Other planners on the same drops: with the readings they give each object's best success (ceiling)."""
+
+ALL: dict[str, Reading] = {r.name: r for r in (*READINGS, *PLANNERS)}
+
+
+def sweep_command(reading: Reading, out: Path, datasets: str, trials: int) -> list[str]:
+    """The multirun that runs one reading on the paper's four settings."""
+    return [
+        sys.executable,
+        "-m",
+        "graspexp",
+        "-m",
+        *SETTINGS_SWEEP,
+        f"dataset={datasets}",
+        f"trials={trials}",
+        "progress=false",
+        "hydra/launcher=joblib",
+        f"hydra.sweep.dir={out / reading.name}",
+        *reading.overrides,
+    ]
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m graspexp.readings", description=__doc__.splitlines()[0])
+    ap.add_argument("out", nargs="?", type=Path, default=Path("outputs/readings"), help="output folder")
+    ap.add_argument("--only", default="", help=f"comma-separated names (default: all of {', '.join(ALL)})")
+    ap.add_argument("--trials", type=int, default=10, help="trials per object and setting (paper: 10)")
+    ap.add_argument("--datasets", default="ycb,linemod", help="Hydra sweep value of dataset=")
+    ap.add_argument("--report-only", action="store_true", help="write the table from what OUT holds")
+    args = ap.parse_args(argv)
+    names = [n for n in args.only.split(",") if n] or list(ALL)
+    unknown = [n for n in names if n not in ALL]
+    if unknown:
+        print(
+            f"graspexp.readings: error: unknown {unknown}; expected some of {', '.join(ALL)}", file=sys.stderr
+        )
+        return 2
+    failed = []
+    if not args.report_only:
+        for i, name in enumerate(names, 1):
+            start = time.perf_counter()
+            print(f"[{i}/{len(names)}] {name}: {ALL[name].what}", file=sys.stderr, flush=True)
+            rc = subprocess.call(sweep_command(ALL[name], args.out, args.datasets, args.trials))
+            print(
+                f"[{i}/{len(names)}] {name}: {time.perf_counter() - start:.0f} s, exit {rc}", file=sys.stderr
+            )
+            if rc != 0:
+                failed.append(name)
+    dirs = {n: args.out / n for n in names if (args.out / n).is_dir()}
+    if not dirs:
+        print(f"graspexp.readings: error: no reading directories below {args.out}", file=sys.stderr)
+        return 2
+    md = readings_report({n: (d, ALL[n].what) for n, d in dirs.items()}, args.out)
+    print(md)
+    if failed:
+        print(f"graspexp.readings: error: sweeps that exited non-zero: {', '.join(failed)}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,182 @@
+"""The readings table: each reading of the paper (and each other planner) x the paper's four settings,
+per dataset, beside the paper's numbers; and per object the best success any of them reached here.
+
+Each reading is read from its own directory (one config per directory, so no row mixes configs); a
+directory whose logs hold two results for one trial, or more than one planner, is refused.
+"""
+
+from pathlib import Path
+
+import pandas as pd
+
+from graspexp.report.collect import collect
+from graspexp.report.paper import PAPER_TABLES, SETTINGS
+from graspexp.report.render import SHORT, fmt_paper, fmt_pct, markdown
+from graspexp.report.tables import AVERAGE, AVERAGE_SAME, success_table
+
+CEILING_KEYS = ("dataset", "object", "mode", "rot")
+
+
+class MixedConfigError(ValueError):
+    """A reading's directory holds results of more than one config."""
+
+
+def _results(name: str, root: Path) -> pd.DataFrame:
+    col = collect(root)
+    df = col.results
+    if col.duplicates:
+        raise MixedConfigError(
+            f"reading {name!r}: {len(col.duplicates)} trials are logged twice below {root} "
+            f"(e.g. {col.duplicates[0][0]}): one directory must hold one config"
+        )
+    if not df.empty and df["planner"].nunique() > 1:
+        raise MixedConfigError(
+            f"reading {name!r}: {root} holds planners {sorted(df['planner'].unique())}: one directory per reading"
+        )
+    return df
+
+
+def _cell(pct: float, lo: float, hi: float) -> str:
+    return f"{fmt_pct(pct)} [{fmt_pct(lo)}, {fmt_pct(hi)}]"
+
+
+def readings_frame(entries: dict[str, tuple[Path, str]]) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(averages, per-object) long tables from the reading directories.
+
+    entries : name -> (directory, one-line description). averages: one row per (reading, dataset, mode,
+    rot) with n, successes, ours_pct, lo_pct, hi_pct (Wilson 95 %, pooled trials), paper_pct (the
+    paper's printed average) and paper_same_pct (the paper's mean over the objects run).
+    per-object: one row per (reading, dataset, object, mode, rot) with n and ours_pct.
+    """
+    avg_rows, obj_rows = [], []
+    for name, (root, what) in entries.items():
+        df = _results(name, root)
+        if df.empty:
+            continue
+        planner = str(df["planner"].iloc[0])
+        for dataset in dict.fromkeys(df["dataset"]):
+            table = success_table(df, dataset, planner)
+            cells = table.cells
+            for _, r in cells[(cells["label"] == AVERAGE) & (cells["n"] > 0)].iterrows():
+                same = cells[
+                    (cells["label"] == AVERAGE_SAME)
+                    & (cells["mode"] == r["mode"])
+                    & (cells["rot"] == r["rot"])
+                ]
+                avg_rows.append(
+                    {
+                        "reading": name,
+                        "what": what,
+                        "dataset": dataset,
+                        "mode": r["mode"],
+                        "rot": r["rot"],
+                        "n": int(r["n"]),
+                        "successes": int(r["successes"]),
+                        "ours_pct": r["ours_pct"],
+                        "lo_pct": r["lo_pct"],
+                        "hi_pct": r["hi_pct"],
+                        "paper_pct": r["paper_pct"],
+                        "paper_same_pct": float(same["paper_pct"].iloc[0]) if len(same) else float("nan"),
+                    }
+                )
+            per_obj = cells[(cells["object"] != "") & (cells["n"] > 0)]
+            for _, r in per_obj.iterrows():
+                obj_rows.append(
+                    {"reading": name, "dataset": dataset, "object": r["object"], "label": r["label"]}
+                    | {"mode": r["mode"], "rot": r["rot"], "n": int(r["n"]), "ours_pct": r["ours_pct"]}
+                )
+    return pd.DataFrame(avg_rows), pd.DataFrame(obj_rows)
+
+
+def _averages_markdown(avg: pd.DataFrame, dataset: str) -> str:
+    sub = avg[avg["dataset"] == dataset]
+    settings = [s for s in SETTINGS if ((sub["mode"] == s[0]) & (sub["rot"] == s[1])).any()]
+    rows = []
+    first = sub.drop_duplicates("reading")
+    paper = sub.drop_duplicates(["mode", "rot"]).set_index(["mode", "rot"])
+    if dataset in PAPER_TABLES:
+        rows.append(
+            {"reading": "paper (printed average)", "what": ""}
+            | {SHORT[s]: fmt_paper(paper.loc[s, "paper_pct"]) for s in settings}
+        )
+        rows.append(
+            {"reading": "paper (same objects as ours)", "what": ""}
+            | {SHORT[s]: fmt_paper(round(paper.loc[s, "paper_same_pct"], 2)) for s in settings}
+        )
+    for _, head in first.iterrows():
+        mine = sub[sub["reading"] == head["reading"]].set_index(["mode", "rot"])
+        row = {"reading": head["reading"], "what": head["what"]}
+        for s in settings:
+            row[SHORT[s]] = (
+                _cell(*mine.loc[s, ["ours_pct", "lo_pct", "hi_pct"]]) if s in mine.index else "n/a"
+            )
+        row["mean of settings"] = fmt_pct(mine["ours_pct"].mean())
+        rows.append(row)
+    return markdown(pd.DataFrame(rows).fillna(""), index=False)
+
+
+def ceiling_frame(per_obj: pd.DataFrame, default: str = "default") -> pd.DataFrame:
+    """Per (dataset, object, setting): the default reading's success, the best any reading or planner
+    reached, and which (ties: the first in the entries' order)."""
+    rows = []
+    for key, sub in per_obj.groupby(list(CEILING_KEYS), sort=False):
+        best = sub.loc[sub["ours_pct"].idxmax()]
+        mine = sub[sub["reading"] == default]["ours_pct"]
+        rows.append(
+            dict(zip(CEILING_KEYS, key, strict=True))
+            | {
+                "label": best["label"],
+                "default_pct": float(mine.iloc[0]) if len(mine) else float("nan"),
+                "best_pct": float(best["ours_pct"]),
+                "best_by": best["reading"],
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def _ceiling_markdown(ceil: pd.DataFrame, dataset: str) -> str:
+    sub = ceil[ceil["dataset"] == dataset]
+    out = {}
+    for (mode, rot), part in sub.groupby(["mode", "rot"], sort=False):
+        out[SHORT[(mode, rot)]] = {
+            r["label"]: f"{fmt_pct(r['default_pct'])} / {fmt_pct(r['best_pct'])} ({r['best_by']})"
+            for _, r in part.iterrows()
+        }
+    frame = pd.DataFrame(out).reindex(list(dict.fromkeys(sub["label"])))
+    frame.index.name = "Object"
+    return markdown(frame[[SHORT[s] for s in SETTINGS if SHORT[s] in frame.columns]])
+
+
+def readings_report(entries: dict[str, tuple[Path, str]], out_dir: Path | str) -> str:
+    """Write ``readings.md``, ``readings.csv`` and ``ceiling.csv`` into ``out_dir``; returns the Markdown."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    avg, per_obj = readings_frame(entries)
+    if avg.empty:
+        text = "# Readings\n\nNo trial logs in the reading directories.\n"
+        (out / "readings.md").write_text(text)
+        return text
+    avg.to_csv(out / "readings.csv", index=False)
+    ceil = ceiling_frame(per_obj)
+    ceil.to_csv(out / "ceiling.csv", index=False)
+    md = [
+        "# Readings of the paper, side by side",
+        "",
+        "Success rate (%) averaged over the paper's objects that were run, Wilson 95 % interval over the "
+        "pooled trials in brackets; one row per reading (one config, one directory each). Every reading is "
+        "a single change from `default` unless it says otherwise; the last rows are other planners on the "
+        "same drops.",
+        "",
+    ]
+    for dataset in dict.fromkeys(avg["dataset"]):
+        title = PAPER_TABLES[dataset].title if dataset in PAPER_TABLES else dataset
+        md += [f"## {dataset}: {title}", "", _averages_markdown(avg, dataset), ""]
+        md += [
+            f"### {dataset}: per object, default / best of any reading or planner (which)",
+            "",
+            _ceiling_markdown(ceil, dataset),
+            "",
+        ]
+    text = "\n".join(md)
+    (out / "readings.md").write_text(text)
+    return text

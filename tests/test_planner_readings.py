@@ -1,0 +1,99 @@
+"""The planner config keys that name the paper's open choices, and the two presets built from them."""
+
+import numpy as np
+import pytest
+from conftest import compose_cfg
+from omegaconf import OmegaConf
+from test_planner_common import RG2, cylinder_cloud, request
+
+from graspexp.config import PlannerConfig
+from graspexp.planning import plan_optimal
+from graspexp.planning.clusters import main_axis
+
+
+def _can_with_band(seed: int = 3):
+    """A 66 mm can on a table at z = 0.1 whose grasping area is its upper 60 mm."""
+    rng = np.random.default_rng(seed)
+    pts = cylinder_cloud(rng, 2048, radius_m=0.033, height_m=0.10) + [0.0, 0.0, 0.1]
+    return pts, pts[:, 2] > 0.14
+
+
+def _plan(**keys):
+    pts, mask = _can_with_band()
+    return plan_optimal(request(pts, mask, table_z=0.1, planner=PlannerConfig(name="optimal", **keys)))
+
+
+def test_cluster_radius_max_is_the_farthest_member_and_sets_the_opening():
+    far, rms = _plan(cluster_radius="max"), _plan(cluster_radius="rms")
+    pts, mask = _can_with_band()
+    area, labels = pts[mask], far.details["labels"]
+    for j, c in enumerate(far.details["centers"]):
+        assert far.details["radii"][j] == pytest.approx(np.linalg.norm(area[labels == j] - c, axis=1).max())
+    assert (far.details["radii"] > rms.details["radii"]).all()
+    k = far.grasp.cluster
+    if not far.grasp.extras["widened"]:
+        expected = min(2 * far.details["radii"][k] * 1.2, RG2.max_width_m)
+        assert far.grasp.width_m == pytest.approx(expected)
+
+
+def test_grasp_point_centre_keeps_c_k_and_section_middle_moves_along_y_only():
+    centre, middle = _plan(grasp_point="centre"), _plan(grasp_point="section_middle")
+    assert (centre.grasp.cluster, centre.grasp.path) == (middle.grasp.cluster, middle.grasp.path)
+    c_k = centre.details["centers"][centre.grasp.cluster]
+    np.testing.assert_array_equal(centre.grasp.pose[:3, 3], c_k)
+    assert centre.grasp.extras["centre_shift_m"] == 0.0
+    offset = middle.grasp.pose[:3, 3] - c_k
+    shift = middle.grasp.extras["centre_shift_m"]
+    np.testing.assert_allclose(offset, shift * middle.grasp.pose[:3, 1], atol=1e-12)
+    lo, hi = middle.details["section_span"][middle.grasp.cluster, middle.grasp.path]
+    assert shift == pytest.approx((lo + hi) / 2)
+
+
+def test_without_the_section_fit_the_cheapest_path_wins_even_if_the_object_is_wider():
+    # Opening 2 r_k with r_k the RMS radius and no margin: far too narrow for the can's 66 mm section.
+    keys = {"cluster_radius": "rms", "width_margin": 0.0, "k": 3}
+    fit, printed = _plan(section_fit=True, **keys), _plan(section_fit=False, **keys)
+    costs = printed.details["costs"]
+    assert printed.grasp.cost == costs.min()
+    assert printed.grasp.extras["n_too_wide"] == 0 and not printed.grasp.extras["widened"]
+    assert printed.grasp.n_feasible == int(np.isfinite(costs).sum())
+    assert printed.grasp.extras["slab_extent_m"] > printed.grasp.width_m  # a pad lands on the object
+    # With the test, the chosen path's section fits the opening it is given.
+    assert fit.grasp.extras["slab_extent_m"] <= fit.grasp.width_m + 1e-12
+    assert fit.grasp.cost >= printed.grasp.cost
+
+
+def test_pose_axis_sets_the_grasp_x_axis_and_main_axis_the_cost_angle():
+    pts, mask = _can_with_band()
+    for source, cloud in (("object", pts), ("area", pts[mask])):
+        res = _plan(pose_axis=source)
+        x, z = res.grasp.pose[:3, 0], res.grasp.pose[:3, 2]
+        a = main_axis(cloud)
+        expected = a - (a @ z) * z
+        np.testing.assert_allclose(x, expected / np.linalg.norm(expected), atol=1e-9)
+        np.testing.assert_array_equal(res.details["pose_axis"], a)
+        np.testing.assert_array_equal(res.details["main_axis"], main_axis(pts))  # alpha unchanged
+
+
+def test_presets_differ_only_in_the_documented_reading_keys():
+    ours, literal = compose_cfg("planner=optimal").planner, compose_cfg("planner=optimal_literal").planner
+    differ = {k for k in ours if ours[k] != literal[k]}
+    assert differ == {"name", "pose_axis", "grasp_point", "section_fit", "width_margin"}
+    assert (literal.pose_axis, literal.grasp_point, literal.section_fit, literal.width_margin) == (
+        "area",
+        "centre",
+        False,
+        0.0,
+    )
+
+
+def test_literal_preset_plans_the_printed_argmin_at_c_k():
+    pts, mask = _can_with_band()
+    cfg = compose_cfg("planner=optimal_literal")
+    pl = OmegaConf.to_object(cfg.planner)
+    res = plan_optimal(request(pts, mask, table_z=0.1, planner=pl))
+    assert res.grasp.planner == "optimal_literal"
+    assert res.grasp.cost == res.details["costs"].min()
+    np.testing.assert_array_equal(res.grasp.pose[:3, 3], res.details["centers"][res.grasp.cluster])
+    expected = min(2 * res.details["radii"][res.grasp.cluster], RG2.max_width_m)
+    assert res.grasp.width_m == pytest.approx(expected)
