@@ -13,11 +13,16 @@ register_configs()
 @hydra.main(version_base="1.3", config_path="../conf", config_name="config")
 def _job(cfg: DictConfig) -> float | None:
     from graspexp.datasets import DatasetError
+    from graspexp.record.live import LiveViewError
     from graspexp.runner import RunError, run_job
 
     try:
         return run_job(cfg)
-    except (DatasetError, RunError) as exc:  # this job cannot run; in a multirun, the others go on
+    except (
+        DatasetError,
+        RunError,
+        LiveViewError,
+    ) as exc:  # this job cannot run; in a multirun, the others go on
         job_failed(str(exc))
     except OSError as exc:  # an input or output file: one line, not a traceback
         job_failed(f"{exc.strerror or exc}: {exc.filename}" if exc.filename else str(exc))

@@ -21,7 +21,7 @@ import socket
 import sys
 import traceback
 from collections.abc import Iterator
-from contextlib import contextmanager, nullcontext
+from contextlib import contextmanager
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
@@ -35,11 +35,12 @@ from graspexp.config import validate
 from graspexp.datasets import DatasetError, available_objects, dataset_objects, load_object
 from graspexp.datasets.model import ObjectModel
 from graspexp.prepare import prepare_shapes
-from graspexp.record import CorruptLogError, TrialRecorder, read_result, read_trial
+from graspexp.record import CorruptLogError, read_result, read_trial, trial_recorder
+from graspexp.record.scene import ObjectScene, object_scene
 from graspexp.seeding import derive_seed
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.outcome import FailureReason, TrialResult
-from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial, scene_entities, trial_seed
+from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
 
 log = logging.getLogger(__name__)
 RESULT_NEUTRAL_KEYS = (
@@ -50,6 +51,8 @@ RESULT_NEUTRAL_KEYS = (
     "dataset.objects",
     "sim.cache_dir",  # where collision shapes are cached; entries are keyed by mesh content
     "sim.prepare_workers",  # how many processes build the collision shapes, not what they build
+    "live",  # whether trials also stream to the Foxglove app
+    "live_port",
 )
 """Config keys (and their sub-keys) that resume ignores when it compares a log's recorded config with the
 current one: they change what is shown or which trials run, never a trial's result. Add presentation-only
@@ -133,15 +136,15 @@ def _error_result(
     )
 
 
-def load_models(cfg: DictConfig, objects: list[str]) -> dict[str, tuple[ObjectModel, list, list]]:
-    """(model, convex hulls, scene entities) of every object, before any trial runs: a missing or broken
+def load_models(cfg: DictConfig, objects: list[str]) -> dict[str, tuple[ObjectModel, list, ObjectScene]]:
+    """(model, convex hulls, Foxglove scene) of every object, before any trial runs: a missing or broken
     mesh, region spec or data folder stops the job here (DatasetError) instead of filling a table."""
     plain = plain_config(cfg)
     out = {}
     for name in objects:
         model = load_object(cfg.dataset, name, cfg.planner.n_points, derive_seed(cfg.seed, "cloud", name))
         hulls = collision_shape(model.mesh, plain.sim)
-        out[name] = (model, hulls, scene_entities(plain, hulls))
+        out[name] = (model, hulls, object_scene(plain, hulls))
     return out
 
 
@@ -150,16 +153,16 @@ def run_object_trials(
     object_name: str,
     run_dir: Path,
     bar: tqdm | None = None,
-    loaded: tuple[ObjectModel, list, list] | None = None,
+    loaded: tuple[ObjectModel, list, ObjectScene] | None = None,
 ) -> list[TrialResult]:
     """Every trial of one object; finished trials found in ``run_dir`` are read back instead of re-run.
 
-    ``loaded``: the object's (model, hulls, entities) from :func:`load_models` (loaded here if None). An
+    ``loaded``: the object's (model, hulls, scene) from :func:`load_models` (loaded here if None). An
     exception inside a trial is that trial's ``error`` result; an unwritable log stops the job (RunError).
     """
     plain = plain_config(cfg)
     job_meta = job_metadata(cfg)
-    model, hulls, entities = loaded or load_models(cfg, [object_name])[object_name]
+    model, hulls, scene = loaded or load_models(cfg, [object_name])[object_name]
     results = []
     for i in range(cfg.trials):
         path = trial_log_path(run_dir, object_name, i)
@@ -168,14 +171,11 @@ def run_object_trials(
         if result is None:
             try:
                 path.parent.mkdir(parents=True, exist_ok=True)
-                recorder = (
-                    TrialRecorder(path, _metadata(job_meta, object_name, i, seed))
-                    if cfg.record
-                    else nullcontext(NullRecorder())
-                )
+                meta = _metadata(job_meta, object_name, i, seed)
+                recorder = trial_recorder(path if cfg.record else None, meta, plain)
                 with recorder as rec:
                     try:
-                        result = run_trial(TrialContext(plain, model, hulls, i, seed, rec, entities))
+                        result = run_trial(TrialContext(plain, model, hulls, i, seed, rec, scene))
                     except OSError:
                         raise
                     except Exception as exc:  # one trial's error is recorded; the sweep goes on

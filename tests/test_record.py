@@ -10,20 +10,22 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import strictly_valid
 from mcap.reader import make_reader
+from mcap_protobuf.decoder import DecoderFactory
 
 from graspexp.geometry import axis_angle_matrix, matrix_to_quat_wxyz
 from graspexp.record import (
     CorruptLogError,
+    OldLogFormatError,
     TrialRecorder,
     TrialWriter,
-    box_entity,
     iter_trial_logs,
-    mesh_entity,
     read_result,
     read_trial,
 )
 from graspexp.record import schemas as S
+from graspexp.record.scene import box_entity, mesh_entity
 from graspexp.sim.outcome import FailureReason, TrialResult
 
 METADATA = {"config": "planner:\n  name: paper\n", "seed": "7", "versions": "graspexp=0.1.0"}
@@ -121,7 +123,7 @@ def write_typical_trial(writer: TrialWriter, n_faces: int = 500) -> None:
         contacts = [
             {
                 "body0": "object",
-                "body1": "table",
+                "body1": "support",
                 "position": (0, 0, 0),
                 "normal": (0, 0, 1),
                 "force_n": (0.0, 0.0, 2.0),
@@ -172,8 +174,9 @@ def test_round_trip_file(trial_file):
     assert log.metadata == METADATA
     assert log.topics == {
         "/scene": "foxglove.SceneUpdate",
-        "/tf": "foxglove.FrameTransform",
-        "/contacts": "graspexp.Contacts@1",
+        "/tf": "foxglove.FrameTransforms",
+        "/grasp_pose": "foxglove.PoseInFrame",
+        "/contacts": "foxglove.PointCloud",
         "/grasp": "graspexp.PlannedGrasp@1",
         "/phase": "graspexp.Phase@1",
         "/result": "graspexp.TrialResult@2",
@@ -204,7 +207,7 @@ def test_round_trip_file(trial_file):
     assert g is not None and g["pose"].shape == (4, 4) and math.isnan(g["cost"])
     assert (g["K"], g["M"], g["n_feasible"], g["cluster"], g["path"]) == (8, 16, 11, 2, 5)
     np.testing.assert_allclose(g["approach"], [0, 0, -1])
-    assert log.message_count == 1 + 7 + 1 + n * 4 + n + 1
+    assert log.message_count == 1 + 7 + 2 + n + n + 1  # scene, phases, grasp + pose, tf, contacts, result
     assert len(log.scenes) == 1 and len(log.scenes[0][1]) == 3
 
 
@@ -238,18 +241,13 @@ def test_success_reason_null_stays_none(tmp_path):
 
 def test_log_times_are_sim_time_ns(trial_file):
     with open(trial_file, "rb") as f:
-        reader = make_reader(f)
-        header = reader.get_header()
-        for _, channel, message in reader.iter_messages():
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        for _, _channel, message, body in reader.iter_decoded_messages(topics=["/tf"]):
             assert message.log_time == message.publish_time
-            if channel.topic == "/tf":
-                body = json.loads(message.data)
-                stamp_ns = body["timestamp"]["sec"] * 1_000_000_000 + body["timestamp"]["nsec"]
-                assert stamp_ns == message.log_time
+            assert all(t.timestamp.ToNanoseconds() == message.log_time for t in body.transforms)
         summary = reader.get_summary()
     assert summary.statistics.message_end_time == 5_000_000_000
     assert summary.statistics.message_start_time == 0
-    assert "graspexp" in header.library
     # 0.1 s -> exactly 100_000_000 ns (rounded, not truncated)
     buf = io.BytesIO()
     w = TrialWriter(buf, {})
@@ -268,75 +266,26 @@ def test_quaternion_order_converted(trial_file):
     q_wxyz = matrix_to_quat_wxyz(axis_angle_matrix(np.array([0.0, 0.0, 1.0]), math.pi / 2))
     np.testing.assert_allclose(q_wxyz, QUAT_Z90_WXYZ, atol=1e-12)
     with open(trial_file, "rb") as f:
-        for _, _channel, message in make_reader(f).iter_messages(topics=["/tf"]):
-            body = json.loads(message.data)
-            if body["child_frame_id"] == "object":
-                rot = body["rotation"]
-                assert list(rot) == ["x", "y", "z", "w"]
-                np.testing.assert_allclose(
-                    [rot["x"], rot["y"], rot["z"], rot["w"]], [0, 0, math.sqrt(0.5), math.sqrt(0.5)]
-                )
-                assert body["parent_frame_id"] == "world"
-                break
-        else:
-            pytest.fail("no /tf message for the object frame")
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        _, _, _, body = next(reader.iter_decoded_messages(topics=["/tf"]))
+    (tf,) = [t for t in body.transforms if t.child_frame_id == "object"]
+    rot = tf.rotation
+    np.testing.assert_allclose([rot.x, rot.y, rot.z, rot.w], [0, 0, math.sqrt(0.5), math.sqrt(0.5)])
+    assert tf.parent_frame_id == "world"
 
 
-def test_standard_reader_reads_everything_and_schemas_are_json_schema(trial_file):
-    """Uses jsonschema (not a dependency) for a full meta-schema check and message validation if present."""
-    try:
-        import jsonschema
-    except ImportError:
-        jsonschema = None
-    counts: dict[str, int] = {}
+def test_every_message_valid_for_independent_readers(trial_file):
     with open(trial_file, "rb") as f:
-        reader = make_reader(f, validate_crcs=True)
-        for schema, channel, message in reader.iter_messages():
-            counts[channel.topic] = counts.get(channel.topic, 0) + 1
-            assert schema.encoding == "jsonschema" and channel.message_encoding == "json"
-            body = json.loads(message.data)
-            assert isinstance(body, dict)
-            if jsonschema is not None:
-                jsonschema.validate(body, json.loads(schema.data))
+        counts = strictly_valid(f)
+        f.seek(0)
+        reader = make_reader(f)
         summary = reader.get_summary()
         metadata = list(reader.iter_metadata())
-    assert counts["/tf"] == 4 * RATE_HZ * DURATION_S and counts["/result"] == 1
+    assert counts["/tf"] == RATE_HZ * DURATION_S and counts["/result"] == 1 and counts["/grasp_pose"] == 1
     assert [m.name for m in metadata] == ["graspexp"] and metadata[0].metadata == METADATA
     names = sorted(s.name for s in summary.schemas.values())
     assert names == sorted(S.TOPIC_SCHEMAS.values())  # each schema registered once
     assert all(c.compression == "lz4" for c in summary.chunk_indexes)
-    for s in summary.schemas.values():
-        doc = json.loads(s.data)
-        assert doc["type"] == "object" and isinstance(doc["properties"], dict)
-        assert doc["title"] == s.name
-        _check_json_schema(doc)
-        if jsonschema is not None:
-            jsonschema.validators.validator_for(doc).check_schema(doc)
-
-
-_JSON_TYPES = {"object", "array", "number", "integer", "string", "boolean", "null"}
-
-
-def _check_json_schema(doc: dict, where: str = "#") -> None:
-    """Structural meta-check of the JSON Schema keywords we use (jsonschema is not a dependency)."""
-    assert isinstance(doc, dict), where
-    kinds = doc.get("type", [])
-    for kind in kinds if isinstance(kinds, list) else [kinds]:
-        assert kind in _JSON_TYPES, f"{where}: bad type {kind!r}"
-    for key in ("title", "description", "$comment", "$schema"):
-        assert isinstance(doc.get(key, ""), str), f"{where}/{key}"
-    for name, sub in doc.get("properties", {}).items():
-        _check_json_schema(sub, f"{where}/properties/{name}")
-    for key in ("items", "additionalProperties"):
-        if isinstance(doc.get(key), dict):
-            _check_json_schema(doc[key], f"{where}/{key}")
-    for i, sub in enumerate(doc.get("oneOf", [])):
-        _check_json_schema(sub, f"{where}/oneOf/{i}")
-    assert set(doc.get("required", [])) <= set(doc.get("properties", {})), (
-        f"{where}: required not in properties"
-    )
-    for key in ("minimum", "maximum", "minItems", "maxItems"):
-        assert isinstance(doc.get(key, 0), int), f"{where}/{key}"
 
 
 def test_scene_entities_follow_foxglove_layout(trial_file):
@@ -445,7 +394,7 @@ def _small_log() -> bytes:
     w.transforms(0.0, {"object": ((0, 0, 0.1), QUAT_Z90_WXYZ)})
     w.contacts(
         0.0,
-        [{"body0": "object", "body1": "table", "position": (0, 0, 0), "normal": (0, 0, 1), "force_n": 1.0}],
+        [{"body0": "object", "body1": "support", "position": (0, 0, 0), "normal": (0, 0, 1), "force_n": 1.0}],
     )
     w.result(0.5, _result())
     w.finish()
@@ -482,8 +431,8 @@ def test_byte_flips_are_corrupt(tmp_path):
 def test_unreadable_json_and_missing_result(tmp_path):
     buf = io.BytesIO()
     w = TrialWriter(buf, METADATA)
-    w._write(S.TOPIC_PHASE, 0.0, {"timestamp": {"sec": 0, "nsec": 0}, "name": "drop"})
-    w._mcap.add_message(channel_id=w._channel(S.TOPIC_PHASE), log_time=1, publish_time=1, data=b"{not json")
+    w.phase(0.0, "drop")
+    w._ch.json[S.TOPIC_PHASE].log(b"{not json", log_time=1)
     w.finish()
     bad = tmp_path / "badjson.mcap"
     bad.write_bytes(buf.getvalue())
@@ -573,3 +522,46 @@ def test_replay_resim_delegates(trial_file, monkeypatch, capsys):
     assert replay.main([str(trial_file), "--resim"]) == 1
     assert "resim: DISAGREES: object dropped" in capsys.readouterr().out
     assert replay.main([str(trial_file)]) == 0  # without the flag, resim is never imported
+
+
+def test_old_json_format_log_result_reads_and_trial_is_refused_in_one_line(tmp_path):
+    """A log of the format before the Foxglove SDK (JSON /tf): report/compare/resume read its result; replay
+    refuses it with one line naming the older format."""
+    from mcap.writer import Writer
+
+    path = tmp_path / "old.mcap"
+    with open(path, "wb") as f:
+        w = Writer(f)
+        w.start(profile="", library="graspexp; mcap")
+        w.add_metadata(S.METADATA_NAME, METADATA)
+        tf_schema = w.register_schema("foxglove.FrameTransform", "jsonschema", b'{"type":"object"}')
+        tf = w.register_channel("/tf", "json", tf_schema)
+        result_schema = w.register_schema(S.TRIAL_RESULT, "jsonschema", S.schema_bytes(S.TRIAL_RESULT))
+        result = w.register_channel("/result", "json", result_schema)
+        w.add_message(tf, log_time=0, publish_time=0, data=b'{"child_frame_id":"object"}')
+        w.add_message(result, log_time=1, publish_time=1, data=json.dumps(_result()).encode())
+        w.finish()
+    assert read_result(path)["reason"] == "slipped"
+    with pytest.raises(OldLogFormatError, match=r"old\.mcap: .*older format") as info:
+        read_trial(path)
+    assert "\n" not in str(info.value)
+    proc = _replay(str(path))
+    assert proc.returncode == 2 and len(proc.stderr.splitlines()) == 1 and "older format" in proc.stderr
+
+
+def test_foxglove_layout_shows_the_logged_topics():
+    """The saved layout names only panels it defines and topics a trial log has."""
+    layout = json.loads((Path(S.__file__).parent / "foxglove_layout.json").read_text())
+
+    def leaves(node):
+        return [node] if isinstance(node, str) else leaves(node["first"]) + leaves(node["second"])
+
+    panels = leaves(layout["layout"])
+    assert sorted(panels) == sorted(layout["configById"])
+    used = set(layout["configById"]["3D!graspexp"]["topics"])
+    for panel in panels:
+        cfg = layout["configById"][panel]
+        used |= {cfg["topicPath"]} if "topicPath" in cfg else set()
+        used |= {p["value"].split(".")[0] for p in cfg.get("paths", [])}
+    assert used == {"/scene", "/contacts", "/grasp_pose", "/phase", "/result", "/grasp"}
+    assert used <= set(S.TOPIC_SCHEMAS)

@@ -6,9 +6,15 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import compose_cfg, strictly_valid
 from mcap.reader import make_reader
 
-from graspexp.record import read_trial
+from graspexp.datasets import load_object
+from graspexp.record import TrialRecorder, read_trial
+from graspexp.record.scene import object_scene
+from graspexp.seeding import derive_seed
+from graspexp.sim.collision_shapes import collision_shape
+from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
 
 pytestmark = pytest.mark.sim
 REPO = Path(__file__).resolve().parent.parent
@@ -36,6 +42,9 @@ def _payloads(path: Path) -> list[tuple[str, int, object]]:
     out = []
     with open(path, "rb") as f:
         for _schema, channel, message in make_reader(f).iter_messages(log_time_order=False):
+            if channel.message_encoding == "protobuf":  # Foxglove topics: compare the encoded bytes
+                out.append((channel.topic, message.log_time, message.data))
+                continue
             data = json.loads(message.data)
             if channel.topic == "/result":
                 data = {k: v for k, v in data.items() if k not in WALL_CLOCK_KEYS}
@@ -58,9 +67,9 @@ def test_job_writes_one_log_per_trial_and_a_results_table(two_runs):
 
 def test_log_reads_back_with_expected_topics_and_schemas(two_runs):
     log = read_trial(two_runs[0] / "trials" / "can" / "000.mcap")
-    assert log.topics["/tf"] == "foxglove.FrameTransform"
+    assert log.topics["/tf"] == "foxglove.FrameTransforms"
     assert log.topics["/scene"] == "foxglove.SceneUpdate"
-    assert log.topics["/contacts"] == "graspexp.Contacts@1"
+    assert log.topics["/contacts"] == "foxglove.PointCloud"
     assert log.topics["/grasp"] == "graspexp.PlannedGrasp@1"
     assert log.topics["/result"] == "graspexp.TrialResult@2"
     assert {"object", "palm", "finger_left", "finger_right"} <= set(log.transforms)
@@ -101,3 +110,54 @@ def test_unknown_object_is_one_clear_error(tmp_path):
     proc = _run_job(tmp_path, "objects=[teapot]")
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines()[-1].startswith("graspexp: error: unknown object(s) ['teapot']")
+
+
+def test_bin_logs_valid_for_independent_readers(two_runs):
+    for path in sorted(two_runs[0].glob("trials/*/*.mcap")):
+        with open(path, "rb") as f:
+            counts = strictly_valid(f)
+        assert counts["/tf"] > 0 and counts["/scene"] >= 1 and counts["/result"] == 1, (path, counts)
+
+
+@pytest.fixture(scope="module")
+def collab_log(tmp_path_factory) -> Path:
+    """One collab trial that grasps and then removes the support, logged in-process."""
+    plain = plain_config(compose_cfg("mode=collab"))
+    name = "can"
+    model = load_object(plain.dataset, name, plain.planner.n_points, derive_seed(plain.seed, "cloud", name))
+    hulls = collision_shape(model.mesh, plain.sim)
+    path = tmp_path_factory.mktemp("collab") / "000.mcap"
+    with TrialRecorder(path, {"object": name}) as rec:
+        ctx = TrialContext(
+            plain, model, hulls, 0, trial_seed(plain, name, 0), rec, object_scene(plain, hulls)
+        )
+        run_trial(ctx)
+    return path
+
+
+def test_collab_log_valid_and_deletes_the_support_when_removed(collab_log):
+    with open(collab_log, "rb") as f:
+        counts = strictly_valid(f)
+    assert counts["/scene"] == 3  # support + hulls, gripper, deletion of the support
+    log = read_trial(collab_log)
+    removed = [t for t, name, _ in log.phases if name == "remove_support"]
+    assert len(removed) == 1, log.phases
+    assert log.scene_deletions == [(removed[0], "support")]
+    (t0, static), (_, gripper) = log.scenes
+    assert t0 == 0.0 and static[0]["id"] == "support" and static[1]["frame_id"] == "object"
+    assert [e["id"] for e in gripper] == ["palm", "finger_left", "finger_right"]
+    (cube,) = static[0]["cubes"]
+    assert set(cube) == {"pose", "size", "color"} and set(cube["pose"]) == {"position", "orientation"}
+    (tri,) = static[1]["triangles"]
+    assert set(tri["points"][0]) == {"x", "y", "z"} and len(tri["indices"]) % 3 == 0
+
+
+def test_trial_bench_prints_both_ratios_for_both_modes(capsys):
+    from graspexp.bench.trials import main
+
+    main(["--objects", "can", "--trials", "1", "--repeats", "0"])
+    out = capsys.readouterr().out
+    for mode in ("collab", "bin"):
+        block = out.split(f"[{mode}]")[1]
+        assert "overhead ratio logged" in block and "overhead ratio unlogged" in block
+        assert "logging per 30 Hz tick" in block and "execution besides physics" in block

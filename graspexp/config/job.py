@@ -46,6 +46,10 @@ class JobConfig:
     """Subset of the dataset's objects; None: all of them."""
     record: bool = True
     """Write one MCAP log per trial."""
+    live: bool = False
+    """Stream the running trials to the Foxglove app over a WebSocket server on 127.0.0.1 (live view)."""
+    live_port: int = 8765
+    """Port of the live-view server (0: any free port)."""
     progress: bool = True
     """Show a progress bar."""
 
@@ -61,6 +65,8 @@ JOB_CONSTRAINTS = {
     "seed": [Interval(0, 2**63 - 1, integer=True)],
     "objects": [None, Names()],
     "record": BOOL,
+    "live": BOOL,
+    "live_port": [Interval(0, 65535, integer=True)],
     "progress": BOOL,
 }
 """Allowed values of the top-level keys; the groups have their own (see :mod:`graspexp.config.constraints`)."""

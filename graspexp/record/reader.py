@@ -1,40 +1,51 @@
 """Read trial logs back: the whole trial (:func:`read_trial`), only its result (:func:`read_result`), and
 the logs of a run directory (:func:`iter_trial_logs`).
 
-Every problem with a file (a ``.partial`` file, bad magic, truncation, a CRC mismatch, unreadable JSON, a
-missing result or metadata record) raises :class:`CorruptLogError` with one message that names the file.
-Before any record is parsed, the file envelope is checked: magic at both ends, the footer, the summary
-CRC and the data-section CRC (the writer sets both), so a truncated or bit-flipped file is rejected up
-front rather than half-read.
+The ``mcap`` library parses the file and checks its magic, record lengths, chunk CRCs and the data-section
+CRC; the summary CRC in the footer, which it does not check, is checked here. Every problem with a file (a
+``.partial`` file, bad magic, truncation, a CRC mismatch, an undecodable message, a missing result or
+metadata record) raises :class:`CorruptLogError` with one line that names the file. Protobuf messages (the
+Foxglove topics) are decoded with the schema stored in the file (``mcap-protobuf-support``).
+
+Logs from before the Foxglove SDK (``/tf`` and ``/scene`` as JSON) still give their result to
+:func:`read_result` (report, compare, resume); :func:`read_trial` refuses them with
+:class:`OldLogFormatError`.
 """
 
 import io
 import json
 import math
 import os
-import struct
 import zlib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
-from mcap.opcode import Opcode
+from mcap.exceptions import EndOfFile, InvalidMagic
 from mcap.reader import SeekingReader
 from mcap.records import Channel, DataEnd, Footer, Message, Metadata, Schema
-from mcap.stream_reader import StreamReader
+from mcap.stream_reader import MAGIC_SIZE, CRCValidationError, StreamReader
+from mcap.writer import MCAP0_MAGIC
+from mcap_protobuf.decoder import DecoderFactory
 
 from graspexp.record import schemas as S
-from graspexp.record.writer import PARTIAL_SUFFIX
 
-MAGIC = b"\x89MCAP0\r\n"
-_FOOTER_SIZE = 1 + 8 + 8 + 8 + 4  # opcode, length, summary_start, summary_offset_start, summary_crc
-_DATA_END_SIZE = 1 + 8 + 4  # opcode, length, data_section_crc
+_FOOTER_TAIL = 4 + MAGIC_SIZE
+"""Bytes after the last field the summary CRC covers: the CRC itself and the closing magic."""
+_FOOTER_SIZE = 1 + 8 + 8 + 8 + 4
+"""A footer record: opcode, length, summary_start, summary_offset_start, summary_crc."""
+_DATA_END_SIZE = 1 + 8 + 4
+"""A data-end record: opcode, length, data_section_crc."""
 
 
 class CorruptLogError(ValueError):
     """A trial log that cannot be trusted: unfinished, truncated, corrupt or incomplete."""
+
+
+class OldLogFormatError(CorruptLogError):
+    """A trial log written by an older graspexp (JSON ``/tf`` and ``/scene``): its result reads, the rest not."""
 
 
 @dataclass
@@ -60,9 +71,12 @@ class TrialLog:
     """topic -> schema name."""
     message_count: int
     scenes: list[tuple[float, list[dict]]] = field(default_factory=list)
-    """(t_s, foxglove.SceneEntity dicts) for each /scene message."""
+    """(t_s, entities) for each /scene message that adds entities: foxglove.SceneEntity as dicts in
+    Foxglove's field layout (id, frame_id, timestamp {sec, nsec}, lifetime, frame_locked, metadata,
+    cubes [{pose {position, orientation}, size, color}], triangles [{pose, points [{x, y, z}], color,
+    colors, indices}])."""
     scene_deletions: list[tuple[float, str]] = field(default_factory=list)
-    """(t_s, entity id) of every scene entity deleted (e.g. the collab support when it is removed)."""
+    """(t_s, entity id) for each entity a /scene message deletes (e.g. the support when it is removed)."""
 
 
 def _name(source: Any) -> str:
@@ -71,160 +85,286 @@ def _name(source: Any) -> str:
     return str(getattr(source, "name", "<stream>"))
 
 
-def _check_envelope(f: IO[bytes], size: int, name: str) -> None:
-    """Magic at both ends, a well-formed footer, the summary CRC and the data-section CRC."""
-    f.seek(0)
-    head = f.read(len(MAGIC))
-    if head != MAGIC[: len(head)] or size == 0:
-        raise CorruptLogError(f"{name}: not an MCAP file (bad magic)" if size else f"{name}: empty file")
-    if size < 2 * len(MAGIC) + _DATA_END_SIZE + _FOOTER_SIZE:
-        raise CorruptLogError(f"{name}: truncated MCAP file ({size} bytes, no footer)")
-    footer_start = size - len(MAGIC) - _FOOTER_SIZE
-    f.seek(footer_start)
-    tail = f.read(_FOOTER_SIZE + len(MAGIC))
-    if tail[_FOOTER_SIZE:] != MAGIC:
-        raise CorruptLogError(f"{name}: truncated or unfinished MCAP file ({size} bytes, no closing magic)")
-    opcode, length, summary_start, _, summary_crc = struct.unpack("<BQQQI", tail[:_FOOTER_SIZE])
-    data_end_start = (summary_start or footer_start) - _DATA_END_SIZE
-    if (
-        opcode != Opcode.FOOTER
-        or length != _FOOTER_SIZE - 9
-        or not len(MAGIC) <= data_end_start < footer_start
-    ):
-        raise CorruptLogError(f"{name}: corrupt MCAP file (bad footer record)")
-    if summary_crc:
-        f.seek(data_end_start + _DATA_END_SIZE)
-        if (
-            zlib.crc32(f.read(footer_start + _FOOTER_SIZE - 4 - data_end_start - _DATA_END_SIZE))
-            != summary_crc
-        ):
-            raise CorruptLogError(f"{name}: corrupt MCAP file (summary CRC mismatch)")
-    f.seek(data_end_start)
-    opcode, length, data_crc = struct.unpack("<BQI", f.read(_DATA_END_SIZE))
-    if opcode != Opcode.DATA_END or length != 4:
-        raise CorruptLogError(f"{name}: corrupt MCAP file (no data-end record before the summary)")
-    if data_crc:
-        f.seek(0)
-        crc, remaining = 0, data_end_start
-        while remaining:
-            block = f.read(min(remaining, 1 << 20))
-            crc, remaining = zlib.crc32(block, crc), remaining - len(block)
-        if crc != data_crc:
-            raise CorruptLogError(f"{name}: corrupt MCAP file (data section CRC mismatch)")
-    f.seek(0)
-
-
-def _parse_error(name: str, exc: BaseException) -> CorruptLogError:
-    detail = str(exc) or type(exc).__name__
-    return CorruptLogError(f"{name}: corrupt MCAP data ({type(exc).__name__}: {detail})")
-
-
 def _reject_partial(name: str) -> None:
-    if name.endswith(PARTIAL_SUFFIX):
+    if name.endswith(S.PARTIAL_SUFFIX):
         raise CorruptLogError(
-            f"{name}: unfinished trial log (a {PARTIAL_SUFFIX} file: the writer did not finish)"
+            f"{name}: unfinished trial log (a {S.PARTIAL_SUFFIX} file: the writer did not finish)"
         )
 
 
-def _decode(name: str, topic: str, schema_name: str, message: Message) -> Any:
+def _corrupt(name: str, data: bytes, exc: Exception) -> CorruptLogError:
+    """One line for a failure of the mcap library on the bytes of ``name``."""
+    if isinstance(exc, InvalidMagic):
+        return CorruptLogError(f"{name}: not an MCAP file (bad magic)")
+    if isinstance(exc, EndOfFile):
+        return CorruptLogError(f"{name}: truncated MCAP file ({len(data)} bytes)")
+    if isinstance(exc, CRCValidationError):
+        return CorruptLogError(f"{name}: corrupt MCAP file ({exc})")
+    return CorruptLogError(f"{name}: corrupt MCAP data ({type(exc).__name__}: {exc})")
+
+
+def _check_summary_crc(data: bytes, footer: Footer, name: str) -> None:
+    """The footer's summary CRC (summary section and footer fields), which the mcap library does not check."""
+    end = len(data) - _FOOTER_TAIL
+    start = footer.summary_start or end - (_FOOTER_SIZE - 4)
+    if footer.summary_crc and zlib.crc32(data[start:end]) != footer.summary_crc:
+        raise CorruptLogError(f"{name}: corrupt MCAP file (summary CRC mismatch)")
+
+
+def _records(data: bytes, name: str) -> list:
+    """Every record of the file, parsed and CRC-checked (chunks, data section) by the mcap library, plus the
+    summary CRC."""
+    if not data:
+        raise CorruptLogError(f"{name}: empty file")
     try:
-        value = json.loads(message.data)
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        records = list(
+            StreamReader(io.BytesIO(data), validate_crcs=True, record_size_limit=len(data)).records
+        )
+    except Exception as exc:  # any parse failure of the bytes means a malformed file
+        raise _corrupt(name, data, exc) from exc
+    if not records or not isinstance(records[-1], Footer) or not any(isinstance(r, DataEnd) for r in records):
+        raise CorruptLogError(f"{name}: truncated or unfinished MCAP file ({len(data)} bytes, no footer)")
+    _check_summary_crc(data, records[-1], name)
+    return records
+
+
+def _result_message(data: bytes, name: str) -> tuple[Channel, str, Message] | None:
+    """The last /result message, its channel and schema name, reading only the chunks that hold /result.
+
+    The mcap library parses the footer, the summary and those chunks (their CRCs); the data-section CRC in the
+    DataEnd record before the summary, which its seeking reader does not check, and the summary CRC are
+    checked here, so a change anywhere in the file is still caught. None: no /result message.
+    """
+    if not data:
+        raise CorruptLogError(f"{name}: empty file")
+    if not data.startswith(MCAP0_MAGIC):
+        raise CorruptLogError(f"{name}: not an MCAP file (bad magic)")
+    if not data.endswith(MCAP0_MAGIC):
         raise CorruptLogError(
-            f"{name}: unreadable JSON on {topic} at t={message.log_time / 1e9:.6f} s ({exc})"
-        ) from exc
-    schema = S.SCHEMAS.get(schema_name)
-    return S.restore_nan(value, schema) if schema is not None else value
+            f"{name}: truncated or unfinished MCAP file ({len(data)} bytes, no closing magic)"
+        )
+    try:
+        stream = io.BytesIO(data)
+        stream.seek(-(_FOOTER_SIZE + MAGIC_SIZE), io.SEEK_END)
+        footer = next(StreamReader(stream, skip_magic=True, record_size_limit=len(data)).records)
+        if not isinstance(footer, Footer) or not _DATA_END_SIZE <= footer.summary_start < len(data):
+            raise CorruptLogError(f"{name}: truncated or unfinished MCAP file ({len(data)} bytes, no footer)")
+        _check_summary_crc(data, footer, name)
+        data_end_at = footer.summary_start - _DATA_END_SIZE
+        stream.seek(data_end_at)
+        data_end = next(StreamReader(stream, skip_magic=True, record_size_limit=len(data)).records)
+        if not isinstance(data_end, DataEnd):
+            raise CorruptLogError(f"{name}: corrupt MCAP file (no data-end record before the summary)")
+        if data_end.data_section_crc and zlib.crc32(data[:data_end_at]) != data_end.data_section_crc:
+            raise CorruptLogError(f"{name}: corrupt MCAP file (data section CRC mismatch)")
+        reader = SeekingReader(io.BytesIO(data), validate_crcs=True, record_size_limit=len(data))
+        found = list(reader.iter_messages(topics=[S.TOPIC_RESULT]))
+    except CorruptLogError:
+        raise
+    except Exception as exc:  # any parse failure of the bytes means a malformed file
+        raise _corrupt(name, data, exc) from exc
+    if not found:
+        return None
+    schema, channel, message = found[-1]
+    return channel, (schema.name if schema is not None else ""), message
+
+
+def _read_bytes(source: Path | str | IO[bytes], name: str) -> bytes:
+    _reject_partial(name)
+    if isinstance(source, (str, os.PathLike)):
+        return Path(source).read_bytes()
+    return source.read()
+
+
+class _Log:
+    """The schemas, channels and messages of one parsed file."""
+
+    def __init__(self, records: list, name: str):
+        self.name = name
+        schemas = {r.id: r for r in records if isinstance(r, Schema)}
+        self.channels: dict[int, Channel] = {r.id: r for r in records if isinstance(r, Channel)}
+        self.schemas: dict[int, Schema | None] = {
+            cid: schemas.get(ch.schema_id) for cid, ch in self.channels.items()
+        }
+        self.topics = {
+            ch.topic: (s.name if (s := self.schemas[cid]) else "") for cid, ch in self.channels.items()
+        }
+        self.metadata = [r for r in records if isinstance(r, Metadata) and r.name == S.METADATA_NAME]
+        self.messages = sorted((r for r in records if isinstance(r, Message)), key=lambda m: m.log_time)
+        contacts = [ch for ch in self.channels.values() if ch.topic == S.TOPIC_CONTACTS]
+        self.bodies = contacts[0].metadata.get("bodies", "").split(",") if contacts else []
+        """The /contacts body names, by index (stored with the channel)."""
+        self._protobuf = DecoderFactory()
+        self._decoders: dict[int, Callable[[bytes], Any]] = {}
+        tf = [ch for ch in self.channels.values() if ch.topic == S.TOPIC_TF]
+        if tf and tf[0].message_encoding == S.MESSAGE_ENCODING:
+            raise OldLogFormatError(
+                f"{name}: a trial log in graspexp's older format (JSON /tf and /scene, before the Foxglove "
+                "SDK): its result is still read by report, compare and resume; re-run the trial to replay it"
+            )
+
+    def decode(self, message: Message) -> tuple[str, Any]:
+        """(topic, decoded message) of a message on a known topic; topic "" for other topics."""
+        ch = self.channels.get(message.channel_id)
+        if ch is None:
+            raise CorruptLogError(
+                f"{self.name}: corrupt MCAP file (message on unknown channel {message.channel_id})"
+            )
+        expected = S.TOPIC_SCHEMAS.get(ch.topic)
+        if expected is None:
+            return "", None
+        encoding = S.MESSAGE_ENCODING if expected in S.SCHEMAS else S.PROTOBUF
+        schema = self.schemas[ch.id]
+        if ch.message_encoding != encoding or schema is None or schema.name != expected:
+            raise CorruptLogError(
+                f"{self.name}: topic {ch.topic} has encoding {ch.message_encoding!r} / schema "
+                f"{self.topics[ch.topic]!r}, expected {encoding!r} / {expected!r}"
+            )
+        where = f"on {ch.topic} at t={message.log_time / 1e9:.6f} s"
+        if encoding == S.MESSAGE_ENCODING:
+            try:
+                value = json.loads(message.data)
+            except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+                raise CorruptLogError(f"{self.name}: unreadable JSON {where} ({exc})") from exc
+            return ch.topic, S.restore_nan(value, S.SCHEMAS[expected])
+        try:
+            decoder = self._decoders.get(ch.id)
+            if decoder is None:
+                decoder = self._decoders[ch.id] = self._protobuf.decoder_for(encoding, schema)
+            return ch.topic, decoder(message.data)
+        except Exception as exc:  # protobuf's DecodeError and the decoder factory's McapError
+            raise CorruptLogError(f"{self.name}: undecodable {expected} message {where} ({exc})") from exc
 
 
 def _nan(v: Any) -> float:
     return math.nan if v is None else float(v)
 
 
+def _xyz(v: Any) -> dict[str, float]:
+    return {"x": v.x, "y": v.y, "z": v.z}
+
+
+def _pose(p: Any) -> dict[str, dict[str, float]]:
+    q = p.orientation
+    return {"position": _xyz(p.position), "orientation": {"x": q.x, "y": q.y, "z": q.z, "w": q.w}}
+
+
+def _rgba(c: Any) -> dict[str, float]:
+    return {"r": c.r, "g": c.g, "b": c.b, "a": c.a}
+
+
+def _entity(e: Any) -> dict:
+    """A protobuf foxglove.SceneEntity as a dict in Foxglove's field layout (the cube and triangle lists)."""
+    return {
+        "timestamp": {"sec": e.timestamp.seconds, "nsec": e.timestamp.nanos},
+        "frame_id": e.frame_id,
+        "id": e.id,
+        "lifetime": {"sec": e.lifetime.seconds, "nsec": e.lifetime.nanos},
+        "frame_locked": e.frame_locked,
+        "metadata": [{"key": kv.key, "value": kv.value} for kv in e.metadata],
+        "cubes": [{"pose": _pose(c.pose), "size": _xyz(c.size), "color": _rgba(c.color)} for c in e.cubes],
+        "triangles": [
+            {
+                "pose": _pose(t.pose),
+                "points": [_xyz(p) for p in t.points],
+                "color": _rgba(t.color),
+                "colors": [_rgba(c) for c in t.colors],
+                "indices": list(t.indices),
+            }
+            for t in e.triangles
+        ],
+    }
+
+
+_CONTACT_DTYPE = np.dtype(
+    {
+        "names": [*S.CONTACT_FLOATS, *S.CONTACT_BODIES],
+        "formats": ["<f4"] * len(S.CONTACT_FLOATS) + ["u1"] * len(S.CONTACT_BODIES),
+        "itemsize": S.CONTACT_STRIDE,
+    }
+)
+
+
+def _contacts(cloud: Any, bodies: list[str]) -> list[dict]:
+    """A /contacts foxglove.PointCloud as dicts: body0, body1, position [3], normal [3], force_n [3], separation_m."""
+    names = [f.name for f in cloud.fields]
+    if cloud.point_stride != S.CONTACT_STRIDE or names != list(_CONTACT_DTYPE.names):
+        raise ValueError(f"contact layout {names} / stride {cloud.point_stride} is not graspexp's")
+    rows = np.frombuffer(cloud.data, dtype=_CONTACT_DTYPE)
+    floats = np.stack([rows[n] for n in S.CONTACT_FLOATS], axis=1).astype(float).tolist()
+    return [
+        {
+            "body0": bodies[b0],
+            "body1": bodies[b1],
+            "position": f[0:3],
+            "normal": f[3:6],
+            "force_n": f[6:9],
+            "separation_m": f[9],
+        }
+        for f, b0, b1 in zip(floats, rows["body0"].tolist(), rows["body1"].tolist(), strict=True)
+    ]
+
+
 def read_trial(source: Path | str | IO[bytes], *, require_result: bool = True) -> TrialLog:
     """Read a whole trial log from a path or a binary stream (e.g. io.BytesIO).
 
-    Raises CorruptLogError for a ``.partial``, truncated or corrupt file, unreadable JSON, a missing
-    ``graspexp`` metadata record, or (with ``require_result``) a missing /result message.
+    Raises CorruptLogError for a ``.partial``, truncated or corrupt file, an undecodable message, a
+    missing ``graspexp`` metadata record, or (with ``require_result``) a missing /result message;
+    OldLogFormatError (a CorruptLogError) for a log in the older JSON format.
     """
     name = _name(source)
-    _reject_partial(name)
-    if isinstance(source, (str, os.PathLike)):
-        data = Path(source).read_bytes()
-        path: Path | None = Path(source)
-    else:
-        data = source.read()
-        path = Path(name) if hasattr(source, "name") else None
-    buf = io.BytesIO(data)
-    _check_envelope(buf, len(data), name)
-    try:
-        records = list(StreamReader(buf, validate_crcs=True, record_size_limit=len(data)).records)
-    except Exception as exc:  # any parse failure of CRC-checked bytes means a malformed file
-        raise _parse_error(name, exc) from exc
-    if not any(isinstance(r, DataEnd) for r in records) or not isinstance(records[-1], Footer):
-        raise CorruptLogError(f"{name}: corrupt MCAP file (no data-end or footer record)")
-
-    schemas = {r.id: r for r in records if isinstance(r, Schema)}
-    channels = {r.id: r for r in records if isinstance(r, Channel)}
-    meta = [r for r in records if isinstance(r, Metadata) and r.name == S.METADATA_NAME]
-    if not meta:
+    data = _read_bytes(source, name)
+    path = (
+        Path(source)
+        if isinstance(source, (str, os.PathLike))
+        else (Path(name) if hasattr(source, "name") else None)
+    )
+    parsed = _Log(_records(data, name), name)
+    if not parsed.metadata:
         raise CorruptLogError(f"{name}: no '{S.METADATA_NAME}' metadata record (not a graspexp trial log)")
-    messages = sorted((r for r in records if isinstance(r, Message)), key=lambda m: m.log_time)
-
-    topics: dict[str, str] = {}
-    for ch in channels.values():
-        topics[ch.topic] = schemas[ch.schema_id].name if ch.schema_id in schemas else ""
     log = TrialLog(
         path=path,
-        metadata=dict(meta[-1].metadata),
+        metadata=dict(parsed.metadata[-1].metadata),
         result=None,
         grasp=None,
         phases=[],
         transforms={},
         contacts=[],
-        topics=topics,
-        message_count=len(messages),
+        topics=parsed.topics,
+        message_count=len(parsed.messages),
     )
     tf: dict[str, list[list[float]]] = {}
-    for m in messages:
-        ch = channels.get(m.channel_id)
-        if ch is None:
-            raise CorruptLogError(f"{name}: corrupt MCAP file (message on unknown channel {m.channel_id})")
-        schema_name = topics[ch.topic]
-        if ch.topic not in S.TOPIC_SCHEMAS:
-            continue
-        if ch.message_encoding != S.MESSAGE_ENCODING or schema_name != S.TOPIC_SCHEMAS[ch.topic]:
-            raise CorruptLogError(
-                f"{name}: topic {ch.topic} has encoding {ch.message_encoding!r} / schema {schema_name!r}, "
-                f"expected {S.MESSAGE_ENCODING!r} / {S.TOPIC_SCHEMAS[ch.topic]!r}"
-            )
+    for m in parsed.messages:
+        topic, msg = parsed.decode(m)
         t_s = m.log_time / 1e9
-        msg = _decode(name, ch.topic, schema_name, m)
         try:
-            if ch.topic == S.TOPIC_TF:
-                tr, rot = msg["translation"], msg["rotation"]
-                row = [t_s, tr["x"], tr["y"], tr["z"], rot["w"], rot["x"], rot["y"], rot["z"]]
-                tf.setdefault(msg["child_frame_id"], []).append([_nan(v) for v in row])
-            elif ch.topic == S.TOPIC_CONTACTS:
-                log.contacts.append((t_s, list(msg["contacts"])))
-            elif ch.topic == S.TOPIC_PHASE:
+            if topic == S.TOPIC_TF:
+                for f in msg.transforms:
+                    tr, rot = f.translation, f.rotation
+                    tf.setdefault(f.child_frame_id, []).append(
+                        [t_s, tr.x, tr.y, tr.z, rot.w, rot.x, rot.y, rot.z]
+                    )
+            elif topic == S.TOPIC_CONTACTS:
+                log.contacts.append((t_s, _contacts(msg, parsed.bodies)))
+            elif topic == S.TOPIC_PHASE:
                 log.phases.append((t_s, str(msg["name"]), msg.get("info")))
-            elif ch.topic == S.TOPIC_GRASP:
+            elif topic == S.TOPIC_GRASP:
                 grasp = {k: v for k, v in msg.items() if k != "timestamp"}
                 grasp["pose"] = np.array([[_nan(v) for v in row] for row in grasp["pose"]], dtype=float)
                 grasp["approach"] = np.array([_nan(v) for v in grasp["approach"]], dtype=float)
                 grasp["t_s"] = t_s
                 log.grasp = grasp
-            elif ch.topic == S.TOPIC_RESULT:
+            elif topic == S.TOPIC_RESULT:
                 if not isinstance(msg, dict) or "success" not in msg:
                     raise ValueError("result lacks 'success'")
                 log.result = msg
-            elif ch.topic == S.TOPIC_SCENE:
-                log.scenes.append((t_s, list(msg["entities"])))
-                log.scene_deletions.extend((t_s, str(d["id"])) for d in msg.get("deletions", []))
-        except (KeyError, TypeError, ValueError, IndexError) as exc:
+            elif topic == S.TOPIC_SCENE:
+                log.scene_deletions.extend((t_s, d.id) for d in msg.deletions)
+                if msg.entities:
+                    log.scenes.append((t_s, [_entity(e) for e in msg.entities]))
+        except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
             raise CorruptLogError(
-                f"{name}: malformed {schema_name} message on {ch.topic} at t={t_s:.6f} s ({exc!r})"
+                f"{name}: malformed {S.TOPIC_SCHEMAS[topic]} message on {topic} at t={t_s:.6f} s ({exc!r})"
             ) from exc
     for frame, rows in tf.items():
         arr = np.asarray(rows, dtype=float).reshape(-1, 8)
@@ -237,29 +377,20 @@ def read_trial(source: Path | str | IO[bytes], *, require_result: bool = True) -
 def read_result(path: Path | str) -> dict:
     """Only the /result message (TrialResult.to_dict() with NaN restored): the fast path for reports.
 
-    The envelope and CRCs are checked as in :func:`read_trial`; only the chunk holding the result is
-    decompressed and decoded.
+    The whole file is CRC-checked as in :func:`read_trial`, but only the chunk holding /result is
+    decompressed and parsed. Logs in the older JSON format are read too (their /result is unchanged).
     """
     name = str(path)
-    _reject_partial(name)
-    with open(path, "rb") as f:
-        size = os.fstat(f.fileno()).st_size
-        _check_envelope(f, size, name)
-        try:
-            found = list(
-                SeekingReader(f, validate_crcs=True, record_size_limit=size).iter_messages(
-                    topics=[S.TOPIC_RESULT]
-                )
-            )
-        except Exception as exc:  # any parse failure of CRC-checked bytes means a malformed file
-            raise _parse_error(name, exc) from exc
-    if not found:
+    found = _result_message(_read_bytes(path, name), name)
+    if found is None:
         raise CorruptLogError(f"{name}: no /result message (the trial did not finish)")
-    schema, channel, message = found[-1]
-    schema_name = schema.name if schema is not None else ""
+    channel, schema_name, message = found
     if schema_name != S.TRIAL_RESULT or channel.message_encoding != S.MESSAGE_ENCODING:
         raise CorruptLogError(f"{name}: /result has schema {schema_name!r}, expected {S.TRIAL_RESULT!r}")
-    result = _decode(name, S.TOPIC_RESULT, schema_name, message)
+    try:
+        result = S.restore_nan(json.loads(message.data), S.SCHEMAS[S.TRIAL_RESULT])
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise CorruptLogError(f"{name}: unreadable JSON on /result ({exc})") from exc
     if not isinstance(result, dict) or "success" not in result:
         raise CorruptLogError(f"{name}: malformed {S.TRIAL_RESULT} message on /result")
     return result
@@ -276,5 +407,5 @@ def iter_trial_logs(run_dir: Path | str) -> Iterator[Path]:
     ``.partial`` files (unfinished trials) are skipped.
     """
     trials = Path(run_dir) / "trials"
-    paths = [p for p in trials.glob("*/*.mcap") if p.is_file() and not p.name.endswith(PARTIAL_SUFFIX)]
+    paths = [p for p in trials.glob("*/*.mcap") if p.is_file() and not p.name.endswith(S.PARTIAL_SUFFIX)]
     yield from sorted(paths, key=_trial_sort_key)

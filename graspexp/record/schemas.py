@@ -1,10 +1,9 @@
-"""JSON Schema documents for every MCAP channel of a trial log, and the NaN <-> null convention.
+"""Topics of a trial log, and the JSON Schemas of graspexp's own messages with the NaN <-> null convention.
 
-Each schema has a versioned name constant. Two are Foxglove well-known schemas, so the log opens in
-Foxglove's 3D panel; their documents follow foxglove/schemas (``schemas/jsonschema/*.json``) for the
-fields graspexp writes (SceneEntity carries only the ``cubes`` and ``triangles`` primitive lists; Foxglove
-recognises the type by its name). The ``graspexp.*@N`` schemas are our own: bump ``N`` whenever a field
-changes meaning or is removed.
+The Foxglove topics (``/tf``, ``/scene``, ``/grasp_pose``, ``/contacts``) carry Foxglove's own protobuf schemas, written
+by the ``foxglove-sdk`` package (see :mod:`graspexp.record.writer`); nothing here copies them. The
+``graspexp.*@N`` schemas are our own JSON Schemas for what no Foxglove schema covers: bump ``N`` whenever a
+field changes meaning or is removed.
 
 NaN and infinities: JSON has no NaN, so the writer encodes every non-finite float as ``null``. In our own
 schemas a float that may be NaN is declared ``{"type": ["number", "null"]}``; :func:`restore_nan` walks a
@@ -23,16 +22,21 @@ from graspexp.sim.outcome import TrialResult
 
 SCHEMA_ENCODING = "jsonschema"
 MESSAGE_ENCODING = "json"
+"""Schema and message encodings of our own topics."""
+PROTOBUF = "protobuf"
+"""Schema and message encoding of the Foxglove topics."""
 
-FRAME_TRANSFORM = "foxglove.FrameTransform"
+FRAME_TRANSFORMS = "foxglove.FrameTransforms"
 SCENE_UPDATE = "foxglove.SceneUpdate"
-CONTACTS = "graspexp.Contacts@1"
+POSE_IN_FRAME = "foxglove.PoseInFrame"
+POINT_CLOUD = "foxglove.PointCloud"
 PLANNED_GRASP = "graspexp.PlannedGrasp@1"
 PHASE = "graspexp.Phase@1"
 TRIAL_RESULT = "graspexp.TrialResult@2"
 
 TOPIC_SCENE = "/scene"
 TOPIC_TF = "/tf"
+TOPIC_GRASP_POSE = "/grasp_pose"
 TOPIC_CONTACTS = "/contacts"
 TOPIC_GRASP = "/grasp"
 TOPIC_PHASE = "/phase"
@@ -40,8 +44,9 @@ TOPIC_RESULT = "/result"
 
 TOPIC_SCHEMAS: dict[str, str] = {
     TOPIC_SCENE: SCENE_UPDATE,
-    TOPIC_TF: FRAME_TRANSFORM,
-    TOPIC_CONTACTS: CONTACTS,
+    TOPIC_TF: FRAME_TRANSFORMS,
+    TOPIC_GRASP_POSE: POSE_IN_FRAME,
+    TOPIC_CONTACTS: POINT_CLOUD,
     TOPIC_GRASP: PLANNED_GRASP,
     TOPIC_PHASE: PHASE,
     TOPIC_RESULT: TRIAL_RESULT,
@@ -68,10 +73,30 @@ PHASE_NAMES = (
 METADATA_NAME = "graspexp"
 """Name of the MCAP metadata record holding the resolved config, seeds and versions."""
 
-_NUMBER_OR_NAN = {"type": ["number", "null"], "description": "null encodes NaN"}
+CONTACT_FLOATS = (
+    "x",
+    "y",
+    "z",
+    "normal_x",
+    "normal_y",
+    "normal_z",
+    "force_x",
+    "force_y",
+    "force_z",
+    "separation",
+)
+"""/contacts is a foxglove.PointCloud in the world frame, one point per touching body pair: these float32
+fields (position m, unit normal, force on body0 N, signed separation m), then ``body0`` and ``body1`` as
+uint8 indices into the body names stored as the channel's metadata ``bodies`` (comma-separated; see
+:func:`graspexp.record.writer.body_names`), padded to :data:`CONTACT_STRIDE` bytes."""
+CONTACT_BODIES = ("body0", "body1")
+CONTACT_STRIDE = 4 * len(CONTACT_FLOATS) + 4
+CONTACT_FORMAT = f"<{len(CONTACT_FLOATS)}f2B2x"
+"""struct format of one /contacts point (little-endian)."""
+PARTIAL_SUFFIX = ".partial"
+"""A log being written (or abandoned) has this suffix after ``.mcap``."""
 
-# ---------------------------------------------------------------------------------------------------
-# Foxglove building blocks (field names and titles as in foxglove/schemas jsonschema)
+_NUMBER_OR_NAN = {"type": ["number", "null"], "description": "null encodes NaN"}
 
 
 def _time(description: str) -> dict:
@@ -86,203 +111,6 @@ def _time(description: str) -> dict:
     }
 
 
-def _duration(description: str) -> dict:
-    return {
-        "type": "object",
-        "title": "duration",
-        "properties": {
-            "sec": {"type": "integer"},
-            "nsec": {"type": "integer", "minimum": 0, "maximum": 999999999},
-        },
-        "description": description,
-    }
-
-
-def _xyz(title: str, description: str, what: str) -> dict:
-    return {
-        "title": title,
-        "description": description,
-        "type": "object",
-        "properties": {k: {"type": "number", "description": f"{k} coordinate {what}"} for k in "xyz"},
-    }
-
-
-def _quaternion(description: str) -> dict:
-    return {
-        "title": "foxglove.Quaternion",
-        "description": description,
-        "type": "object",
-        "properties": {k: {"type": "number", "description": f"{k} value"} for k in "xyzw"},
-    }
-
-
-def _color(description: str) -> dict:
-    names = {"r": "Red", "g": "Green", "b": "Blue", "a": "Alpha"}
-    return {
-        "title": "foxglove.Color",
-        "description": description,
-        "type": "object",
-        "properties": {
-            k: {"type": "number", "description": f"{v} value between 0 and 1"} for k, v in names.items()
-        },
-    }
-
-
-def _pose(description: str) -> dict:
-    return {
-        "title": "foxglove.Pose",
-        "description": description,
-        "type": "object",
-        "properties": {
-            "position": _xyz("foxglove.Vector3", "Point denoting position in 3D space", "length"),
-            "orientation": _quaternion("Quaternion denoting orientation in 3D space"),
-        },
-    }
-
-
-def _cube_primitive() -> dict:
-    return {
-        "title": "foxglove.CubePrimitive",
-        "description": "A primitive representing a cube or rectangular prism",
-        "type": "object",
-        "properties": {
-            "pose": _pose("Position of the center of the cube and orientation of the cube"),
-            "size": _xyz("foxglove.Vector3", "Size of the cube along each axis", "length"),
-            "color": _color("Color of the cube"),
-        },
-    }
-
-
-def _triangle_list_primitive() -> dict:
-    return {
-        "title": "foxglove.TriangleListPrimitive",
-        "description": "A primitive representing a set of triangles or a surface tiled by triangles",
-        "type": "object",
-        "properties": {
-            "pose": _pose("Origin of triangles relative to reference frame"),
-            "points": {
-                "type": "array",
-                "items": _xyz("foxglove.Point3", "A point representing a position in 3D space", "position"),
-                "description": "Vertices to use for triangles, interpreted as a list of triples (0-1-2, 3-4-5, ...)",
-            },
-            "color": _color(
-                "Solid color to use for the whole shape. One of `color` or `colors` must be provided."
-            ),
-            "colors": {
-                "type": "array",
-                "items": _color("A color in RGBA format"),
-                "description": "Per-vertex colors (if specified, must have the same length as `points`).",
-            },
-            "indices": {
-                "type": "array",
-                "items": {"type": "integer", "minimum": 0},
-                "description": "Indices into the `points` and `colors` attribute arrays (empty: no indexing).",
-            },
-        },
-    }
-
-
-def _scene_entity() -> dict:
-    return {
-        "title": "foxglove.SceneEntity",
-        "description": "A visual element in a 3D scene. An entity may be composed of multiple primitives which "
-        "all share the same frame of reference.",
-        "type": "object",
-        "properties": {
-            "timestamp": _time("Timestamp of the entity"),
-            "frame_id": {"type": "string", "description": "Frame of reference"},
-            "id": {"type": "string", "description": "Identifier for the entity."},
-            "lifetime": _duration(
-                "Length of time (relative to `timestamp`) after which the entity should be "
-                "automatically removed. Zero value: remain until replaced or deleted."
-            ),
-            "frame_locked": {
-                "type": "boolean",
-                "description": "Whether the entity should keep its location in the fixed frame (false) or "
-                "follow the frame specified in `frame_id` as it moves relative to the fixed frame (true)",
-            },
-            "metadata": {
-                "type": "array",
-                "items": {
-                    "title": "foxglove.KeyValuePair",
-                    "description": "A key with its associated value",
-                    "type": "object",
-                    "properties": {
-                        "key": {"type": "string", "description": "Key"},
-                        "value": {"type": "string", "description": "Value"},
-                    },
-                },
-                "description": "Additional user-provided metadata associated with the entity.",
-            },
-            "cubes": {"type": "array", "items": _cube_primitive(), "description": "Cube primitives"},
-            "triangles": {
-                "type": "array",
-                "items": _triangle_list_primitive(),
-                "description": "Triangle list primitives",
-            },
-        },
-    }
-
-
-def _scene_update() -> dict:
-    return {
-        "title": SCENE_UPDATE,
-        "description": "An update to the entities displayed in a 3D scene",
-        "type": "object",
-        "properties": {
-            "deletions": {
-                "type": "array",
-                "items": {
-                    "title": "foxglove.SceneEntityDeletion",
-                    "description": "Command to remove previously published entities",
-                    "type": "object",
-                    "properties": {
-                        "timestamp": _time("Only matching entities earlier than this timestamp are deleted."),
-                        "type": {
-                            "title": "foxglove.SceneEntityDeletionType",
-                            "description": "Type of deletion action to perform",
-                            "oneOf": [
-                                {"title": "MATCHING_ID", "const": 0, "description": "Delete the entity `id`"},
-                                {
-                                    "title": "ALL",
-                                    "const": 1,
-                                    "description": "Delete all entities on the topic",
-                                },
-                            ],
-                        },
-                        "id": {"type": "string", "description": "Identifier, if `type` is `MATCHING_ID`."},
-                    },
-                },
-                "description": "Scene entities to delete",
-            },
-            "entities": {
-                "type": "array",
-                "items": _scene_entity(),
-                "description": "Scene entities to add or replace",
-            },
-        },
-    }
-
-
-def _frame_transform() -> dict:
-    return {
-        "title": FRAME_TRANSFORM,
-        "description": "A transform between two reference frames in 3D space",
-        "type": "object",
-        "properties": {
-            "timestamp": _time("Timestamp of transform"),
-            "parent_frame_id": {"type": "string", "description": "Name of the parent frame"},
-            "child_frame_id": {"type": "string", "description": "Name of the child frame"},
-            "translation": _xyz("foxglove.Vector3", "Translation component of the transform", "length"),
-            "rotation": _quaternion("Rotation component of the transform"),
-        },
-    }
-
-
-# ---------------------------------------------------------------------------------------------------
-# graspexp's own schemas
-
-
 def _vec3(description: str) -> dict:
     return {
         "type": "array",
@@ -290,32 +118,6 @@ def _vec3(description: str) -> dict:
         "minItems": 3,
         "maxItems": 3,
         "description": description,
-    }
-
-
-def _contacts() -> dict:
-    contact = {
-        "type": "object",
-        "properties": {
-            "body0": {"type": "string", "description": "Name of the first body"},
-            "body1": {"type": "string", "description": "Name of the second body"},
-            "position": _vec3("Contact point, world frame, m"),
-            "normal": _vec3("Unit contact normal, world frame, as the simulator reports it"),
-            "force_n": _vec3("Contact force on body0 (simulator impulse / time step), world frame, N"),
-            "separation_m": {**_NUMBER_OR_NAN, "description": "Signed distance, m (negative: penetration)"},
-        },
-        "required": ["body0", "body1", "position", "normal", "force_n", "separation_m"],
-    }
-    return {
-        "$schema": "https://json-schema.org/draft/2020-12/schema",
-        "title": CONTACTS,
-        "description": "All contact points of one simulation step. Magnitude: the norm of `force_n`.",
-        "type": "object",
-        "properties": {
-            "timestamp": _time("Simulation time of the step"),
-            "contacts": {"type": "array", "items": contact},
-        },
-        "required": ["timestamp", "contacts"],
     }
 
 
@@ -404,14 +206,11 @@ def _trial_result() -> dict:
 
 
 SCHEMAS: dict[str, dict] = {
-    FRAME_TRANSFORM: _frame_transform(),
-    SCENE_UPDATE: _scene_update(),
-    CONTACTS: _contacts(),
     PLANNED_GRASP: _planned_grasp(),
     PHASE: _phase(),
     TRIAL_RESULT: _trial_result(),
 }
-"""Schema name -> JSON Schema document."""
+"""Our own schema name -> JSON Schema document (the Foxglove topics carry protobuf schemas from the SDK)."""
 
 
 def schema_bytes(name: str) -> bytes:

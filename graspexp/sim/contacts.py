@@ -1,22 +1,34 @@
-"""Contact queries on a live scene: the one place that decides what "touching" and "holding" mean."""
+"""Contact queries on a live scene: the one place that decides what "touching" and "holding" mean.
+
+These run inside the step loop, so they work on plain Python floats (a few contacts of a few points each:
+numpy's per-call overhead would cost more than the arithmetic).
+"""
+
+import math
 
 import numpy as np
 import sapien
 
-from graspexp.sim.gripper import FINGER_NAMES
-from graspexp.sim.scene import OBJECT_NAME, SUPPORT_NAME
+from graspexp.sim.gripper import FINGER_NAMES, PALM_NAME
+from graspexp.sim.scene import OBJECT_NAME
 
-GRIPPER_LINKS = frozenset({*FINGER_NAMES, "palm"})
+GRIPPER_LINKS = frozenset({*FINGER_NAMES, PALM_NAME})
 MIN_IMPULSE_NS = 1e-9
 """Contact points with a smaller impulse are proximity reports inside contact_offset, not touches."""
 
 
 def _pair_names(contact: sapien.physx.PhysxContact) -> tuple[str, str]:
-    return contact.bodies[0].entity.name, contact.bodies[1].entity.name
+    b0, b1 = contact.bodies
+    return b0.entity.name, b1.entity.name
 
 
 def _touching(contact: sapien.physx.PhysxContact) -> bool:
-    return any(np.linalg.norm(p.impulse) > MIN_IMPULSE_NS for p in contact.points)
+    limit = MIN_IMPULSE_NS * MIN_IMPULSE_NS
+    for p in contact.points:
+        x, y, z = p.impulse.tolist()
+        if x * x + y * y + z * z > limit:
+            return True
+    return False
 
 
 def finger_forces(contacts: list, dt: float, closing_axis: np.ndarray) -> dict[str, float]:
@@ -34,13 +46,25 @@ def finger_forces(contacts: list, dt: float, closing_axis: np.ndarray) -> dict[s
     return out
 
 
-def gripper_touches_support(contacts: list) -> bool:
-    """True if any gripper link presses on the support in the last step."""
-    for c in contacts:
-        a, b = _pair_names(c)
-        if SUPPORT_NAME in (a, b) and (a in GRIPPER_LINKS or b in GRIPPER_LINKS) and _touching(c):
-            return True
-    return False
+class SupportTouch:
+    """Whether any gripper link presses on the support in the last step: only the gripper-support pairs are
+    inspected (their bodies are matched by identity, without reading names or other pairs' points).
+
+    support : the support's physx component; links : the gripper's link components.
+    """
+
+    def __init__(self, support: sapien.physx.PhysxRigidBaseComponent, links: list):
+        self.support = support
+        self.links = tuple(links)
+
+    def __call__(self, contacts: list) -> bool:
+        support, links = self.support, self.links
+        for c in contacts:
+            b0, b1 = c.bodies
+            if (b0 is support and b1 in links) or (b1 is support and b0 in links):
+                if _touching(c):
+                    return True
+        return False
 
 
 def contact_records(contacts: list, dt: float) -> list[dict]:
@@ -49,23 +73,32 @@ def contact_records(contacts: list, dt: float) -> list[dict]:
     Pairs whose points all carry (near) zero impulse are proximity reports and are left out."""
     out = []
     for c in contacts:
-        pts = c.points
-        imp = np.array([p.impulse for p in pts], dtype=float)
-        w = np.sqrt((imp * imp).sum(axis=1))
-        total = float(w.sum())
-        if total <= MIN_IMPULSE_NS:
+        w_sum = px = py = pz = nx = ny = nz = fx = fy = fz = 0.0
+        sep = math.inf
+        for p in c.points:
+            sep = min(sep, p.separation)
+            ix, iy, iz = p.impulse.tolist()
+            w = math.sqrt(ix * ix + iy * iy + iz * iz)
+            if w == 0.0:
+                continue
+            x, y, z = p.position.tolist()
+            a, b, d = p.normal.tolist()
+            w_sum += w
+            px, py, pz = px + w * x, py + w * y, pz + w * z
+            nx, ny, nz = nx + w * a, ny + w * b, nz + w * d
+            fx, fy, fz = fx + ix, fy + iy, fz + iz
+        if w_sum <= MIN_IMPULSE_NS:
             continue
-        a, b = _pair_names(c)
-        pos = np.array([p.position for p in pts], dtype=float)
-        nrm = (w @ np.array([p.normal for p in pts], dtype=float)) / total
+        n = math.sqrt(nx * nx + ny * ny + nz * nz) or w_sum
+        b0, b1 = _pair_names(c)
         out.append(
             {
-                "body0": a,
-                "body1": b,
-                "position": ((w @ pos) / total).tolist(),
-                "normal": (nrm / (np.linalg.norm(nrm) or 1.0)).tolist(),
-                "force_n": (imp.sum(axis=0) / dt).tolist(),
-                "separation_m": float(min(p.separation for p in pts)),
+                "body0": b0,
+                "body1": b1,
+                "position": [px / w_sum, py / w_sum, pz / w_sum],
+                "normal": [nx / n, ny / n, nz / n],
+                "force_n": [fx / dt, fy / dt, fz / dt],
+                "separation_m": float(sep),
             }
         )
     return out

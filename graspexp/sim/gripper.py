@@ -9,7 +9,8 @@ joints near zero during a trial (no gimbal lock): the protocol holds them at 0 a
 translation offsets (pre-grasp, extend, pull back, lift), as the paper's end effector does.
 """
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, field
 
 import numpy as np
 import sapien
@@ -55,6 +56,8 @@ class Gripper:
     joints: list
     close_target_m: float
     """Finger joint target when closing (negative: past fully closed), m; see :data:`CLOSE_FORCE_MARGIN`."""
+    arm_targets: list[float] = field(default_factory=lambda: [math.nan] * 3)
+    """The x, y, z drive targets last set, m (NaN: none yet)."""
 
     def set_state(self, offset: np.ndarray, half_width_m: float) -> None:
         """Teleport to TCP offset (3,) in the grasp frame, fingers at ``half_width_m``; zero velocity."""
@@ -65,9 +68,13 @@ class Gripper:
         self.drive_fingers(half_width_m)
 
     def drive_arm(self, offset: np.ndarray) -> None:
-        """Position targets of the x, y, z joints: TCP offset in the grasp frame, metres."""
-        for joint, value in zip(self.joints[:3], offset, strict=True):
-            joint.set_drive_target(float(value))
+        """Position targets of the x, y, z joints: TCP offset (3,) in the grasp frame, metres. The step loop
+        calls this every step, so a joint whose target is unchanged is left alone."""
+        targets = np.asarray(offset, dtype=float).tolist()
+        for i, (joint, value) in enumerate(zip(self.joints[:3], targets, strict=True)):
+            if value != self.arm_targets[i]:
+                joint.set_drive_target(value)
+                self.arm_targets[i] = value
 
     def drive_fingers(self, half_width_m: float) -> None:
         for joint in self.joints[N_BASE:]:

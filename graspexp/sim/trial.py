@@ -9,10 +9,10 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
+import sapien
 from omegaconf import DictConfig, OmegaConf
 
 from graspexp.config import JobConfig
-from graspexp.config.gripper import finger_z_range_m
 from graspexp.datasets.model import ObjectModel
 from graspexp.geometry import axis_angle_matrix, make_pose, random_rotation, transform_points, yaw_rotation
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
@@ -20,10 +20,10 @@ from graspexp.planning.registry import plan
 from graspexp.planning.request import PlanRequest
 from graspexp.quality import grasp_quality
 from graspexp.seeding import derive_seed, rng_for
-from graspexp.sim.contacts import contact_records, finger_forces, gripper_touches_support
+from graspexp.sim.contacts import SupportTouch, contact_records, finger_forces
 from graspexp.sim.gripper import FINGER_NAMES, Gripper, build_gripper
 from graspexp.sim.outcome import FailureReason, TrialResult
-from graspexp.sim.scene import TrialScene, build_scene
+from graspexp.sim.scene import SUPPORT_NAME, TrialScene, build_scene
 
 FELL_BELOW_M = 0.05
 """An object whose origin is this far below the support plane has fallen off it, m."""
@@ -60,8 +60,9 @@ class TrialContext:
     trial: int
     trial_seed: int
     recorder: object = field(default_factory=NullRecorder)
-    entities: list[dict] | None = None
-    """The static scene for the log (:func:`scene_entities`); computed per trial when None."""
+    scene: object | None = None
+    """The object's Foxglove scene for the log (:func:`graspexp.record.object_scene`, built once per object);
+    None: no /scene messages."""
 
 
 def plain_config(cfg: DictConfig) -> JobConfig:
@@ -102,7 +103,11 @@ def perceived_pose(
 
 
 class _Sim:
-    """Steps one trial's scene, keeps sim time, checks stability and table touches, logs at a fixed rate."""
+    """Steps one trial's scene, keeps sim time, checks stability and table touches, logs at a fixed rate.
+
+    Between log ticks a step does only the physics step, the object's speed check (two velocity reads and
+    two dot products) and, while :meth:`watch_support` is on, the gripper-support contact check.
+    """
 
     def __init__(self, ts: TrialScene, cfg: JobConfig, recorder, timings: dict[str, float]):
         self.ts, self.cfg, self.rec, self.timings = ts, cfg, recorder, timings
@@ -110,10 +115,23 @@ class _Sim:
         self.t, self.steps = 0.0, 0
         self.log_every = max(1, round(1.0 / (cfg.sim.log_rate_hz * self.dt)))
         self.gripper: Gripper | None = None
-        self.watch_support = False
+        self._links: list | None = None
+        self.touch: SupportTouch | None = None
         self.touched_support = False
         self.max_speed_sq = float(cfg.sim.max_speed_mps) ** 2
         self.recording = getattr(recorder, "active", True)
+        self._next_log = self.log_every if self.recording else -1
+        self._physx_step = ts.scene.physx_system.step
+        self._contacts = ts.scene.physx_system.get_contacts
+        body = ts.object_body
+        self._velocities = (body.get_linear_velocity, body.get_angular_velocity)
+        self.speed_sq = (0.0, 0.0)
+        """The object's squared linear (m^2/s^2) and angular (rad^2/s^2) speed after the last step."""
+
+    def watch_support(self, gripper: Gripper) -> None:
+        """From now on a gripper link touching the support fails the trial (COLLISION_SUPPORT)."""
+        support = self.ts.support.find_component_by_type(sapien.physx.PhysxRigidStaticComponent)
+        self.touch = SupportTouch(support, [gripper.palm, *gripper.fingers])
 
     def run(self, seconds: float, each_step=None) -> None:
         n = max(1, int(round(seconds / self.dt)))
@@ -124,43 +142,44 @@ class _Sim:
 
     def step(self) -> None:
         t0 = time.perf_counter()
-        self.ts.scene.step()
+        self._physx_step()
         self.timings["physics"] += time.perf_counter() - t0
         self.steps += 1
         self.t = self.steps * self.dt
-        self._check_stable()
-        if self.watch_support and gripper_touches_support(self.ts.scene.get_contacts()):
+        linear, angular = self._velocities
+        v, w = linear(), angular()
+        vv, ww = self.speed_sq = v.dot(v), w.dot(w)
+        if not (vv <= self.max_speed_sq and ww < 1e12):  # NaN fails every comparison
+            raise TrialFailed(
+                FailureReason.SIM_UNSTABLE, f"object speed {float(vv) ** 0.5:.3g} m/s at t={self.t:.3f} s"
+            )
+        if self.touch is not None and self.touch(self._contacts()):
             self.touched_support = True
-            self.log()
+            if self.recording:
+                self.log()
             raise TrialFailed(
                 FailureReason.COLLISION_SUPPORT, f"gripper touched the support at t={self.t:.3f} s"
             )
-        if self.recording and self.steps % self.log_every == 0:
+        if self.steps == self._next_log:
+            self._next_log += self.log_every
             self.log()
 
-    def _check_stable(self) -> None:
-        body = self.ts.object_body
-        v, w = body.linear_velocity, body.angular_velocity
-        vv, ww = float(v @ v), float(w @ w)
-        if not (vv <= self.max_speed_sq and ww < 1e12):  # NaN fails every comparison
-            raise TrialFailed(
-                FailureReason.SIM_UNSTABLE, f"object speed {vv**0.5:.3g} m/s at t={self.t:.3f} s"
-            )
-
     def frames(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-        """World poses (position, quaternion wxyz) of the logged frames."""
+        """World poses (position (3,) m, quaternion wxyz (4,)) of the logged frames."""
         p = self.ts.object_entity.pose
         out = {"object": (p.p, p.q)}
         if self.gripper is not None:
-            for link in (self.gripper.palm, *self.gripper.fingers):
+            if self._links is None:
+                self._links = [(link.name, link) for link in (self.gripper.palm, *self.gripper.fingers)]
+            for name, link in self._links:
                 lp = link.entity_pose
-                out[link.name] = (lp.p, lp.q)
+                out[name] = (lp.p, lp.q)
         return out
 
     def log(self) -> None:
         t0 = time.perf_counter()
         self.rec.transforms(self.t, self.frames())
-        self.rec.contacts(self.t, contact_records(self.ts.scene.get_contacts(), self.dt))
+        self.rec.contacts(self.t, contact_records(self._contacts(), self.dt))
         self.timings["log"] += time.perf_counter() - t0
 
     @contextmanager
@@ -181,17 +200,15 @@ class _Sim:
 def _settle(sim: _Sim) -> bool:
     """Step until the object rests, falls below the support, or the time cap; True if it is on the support."""
     cfg = sim.cfg.sim
-    body, entity = sim.ts.object_body, sim.ts.object_entity
+    body = sim.ts.object_body
     min_steps = int(cfg.settle_min_s / sim.dt)
     below_z = sim.ts.table_z - FELL_BELOW_M
+    linear_sq, angular_sq = cfg.settle_linear_mps**2, cfg.settle_angular_radps**2
     for _ in range(int(cfg.settle_max_s / sim.dt)):
         sim.step()
-        if entity.pose.p[2] < below_z:
+        if body.get_entity_pose().p[2] < below_z:
             return False
-        if sim.steps >= min_steps and (
-            np.linalg.norm(body.linear_velocity) < cfg.settle_linear_mps
-            and np.linalg.norm(body.angular_velocity) < cfg.settle_angular_radps
-        ):
+        if sim.steps >= min_steps and sim.speed_sq[0] < linear_sq and sim.speed_sq[1] < angular_sq:
             break
     return _on_support(sim.ts, sim.cfg)
 
@@ -202,35 +219,6 @@ def _on_support(ts: TrialScene, cfg: JobConfig) -> bool:
     com = (ts.object_entity.pose * ts.object_body.cmass_local_pose).p
     hx, hy = cfg.mode.support_half_size_m
     return bool(lo[2] > ts.table_z - 0.01 and abs(com[0]) <= hx and abs(com[1]) <= hy)
-
-
-def scene_entities(cfg: JobConfig, hulls: list[np.ndarray]) -> list[dict]:
-    """Foxglove scene entities: the support (world frame) and the object's collision hulls (object frame)."""
-    from graspexp.record import box_entity, mesh_entity
-    from graspexp.sim.collision_shapes import hull_meshes
-
-    h = cfg.mode.support_height_m
-    hx, hy = cfg.mode.support_half_size_m
-    ents = [box_entity("support", "world", [0.0, 0.0, h / 2], [2 * hx, 2 * hy, h], [0.6, 0.45, 0.3, 1.0])]
-    for i, m in enumerate(hull_meshes(hulls)):
-        ents.append(mesh_entity(f"object_hull_{i}", "object", m.vertices, m.faces, [0.2, 0.4, 0.9, 1.0]))
-    return ents
-
-
-def _gripper_entities(cfg: JobConfig) -> list[dict]:
-    from graspexp.record import box_entity
-
-    g = cfg.gripper
-    L, t = g.finger_length_m, g.finger_thickness_m
-    root_z, _ = finger_z_range_m(g)
-    px, py, pz = g.palm_size_m
-    grey = [0.5, 0.5, 0.5, 1.0]
-    ents = [box_entity("palm", "palm", [0.0, 0.0, root_z - pz / 2], [px, py, pz], grey)]
-    for name, sign in zip(FINGER_NAMES, (1.0, -1.0), strict=True):
-        ents.append(
-            box_entity(name, name, [0.0, sign * t / 2, root_z + L / 2], [g.finger_width_m, t, L], grey)
-        )
-    return ents
 
 
 def _grasp_record(grasp: Grasp) -> dict:
@@ -294,10 +282,8 @@ def _drop_until_on_support(ctx: TrialContext, res: TrialResult, timings: dict) -
         ts = build_scene(ctx.hulls, ctx.model.mass_kg, pose, cfg.mode, cfg.sim)
         timings["build"] += time.perf_counter() - t0
         sim = _Sim(ts, cfg, ctx.recorder, timings)
-        if attempt == 0:
-            ctx.recorder.scene(
-                0.0, ctx.entities if ctx.entities is not None else scene_entities(cfg, ctx.hulls)
-            )
+        if attempt == 0 and ctx.scene is not None:
+            ctx.recorder.scene(0.0, ctx.scene.static)
         sim.phase("drop", {"attempt": attempt})
         with sim.timed("settle"):
             on_support = _settle(sim)
@@ -362,8 +348,10 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
     ts = sim.ts
     gripper = build_gripper(ts.scene, cfg.gripper, grasp.pose, mode.support_collides_with_gripper)
     sim.gripper = gripper
-    ctx.recorder.scene(sim.t, _gripper_entities(cfg))
-    sim.watch_support = bool(mode.support_collides_with_gripper)
+    if ctx.scene is not None:
+        ctx.recorder.scene(sim.t, ctx.scene.gripper)
+    if mode.support_collides_with_gripper:
+        sim.watch_support(gripper)
     standoff = float(cfg.planner.sphere_radius_m)
     half = grasp.width_m / 2
     gripper.set_state(np.array([0.0, 0.0, -standoff]), half)
@@ -385,6 +373,7 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
     if mode.remove_support_after_grasp:
         sim.phase("remove_support")
         ts.remove_support()
+        ctx.recorder.delete_entities(sim.t, [SUPPORT_NAME])
     if mode.pull_back_m > 0:
         sim.phase("pull_back", {"distance_m": mode.pull_back_m})
         sim.run(
