@@ -34,10 +34,11 @@ from tqdm import tqdm
 from graspexp.config import validate
 from graspexp.datasets import DatasetError, available_objects, dataset_objects, load_object
 from graspexp.datasets.model import ObjectModel
+from graspexp.prepare import prepare_shapes
 from graspexp.record import CorruptLogError, read_result, read_trial, trial_recorder
 from graspexp.record.scene import ObjectScene, object_scene
 from graspexp.seeding import derive_seed
-from graspexp.sim.collision import convex_hulls
+from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.outcome import FailureReason, TrialResult
 from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
 
@@ -48,7 +49,8 @@ RESULT_NEUTRAL_KEYS = (
     "trials",  # which trials run, not what one gives (a trial's seed derives from its object and index)
     "objects",
     "dataset.objects",
-    "sim.cache_dir",  # where convex decompositions are cached; entries are keyed by mesh content
+    "sim.cache_dir",  # where collision shapes are cached; entries are keyed by mesh content
+    "sim.prepare_workers",  # how many processes build the collision shapes, not what they build
     "live",  # whether trials also stream to the Foxglove app
     "live_port",
 )
@@ -141,7 +143,7 @@ def load_models(cfg: DictConfig, objects: list[str]) -> dict[str, tuple[ObjectMo
     out = {}
     for name in objects:
         model = load_object(cfg.dataset, name, cfg.planner.n_points, derive_seed(cfg.seed, "cloud", name))
-        hulls = convex_hulls(model.mesh, plain.sim)
+        hulls = collision_shape(model.mesh, plain.sim)
         out[name] = (model, hulls, object_scene(plain, hulls))
     return out
 
@@ -311,6 +313,7 @@ def run_in_dir(cfg: DictConfig, run_dir: Path) -> float:
 def _run(cfg: DictConfig, run_dir: Path) -> float:
     objects = select_objects(cfg)
     check_resumable(cfg, run_dir)
+    prepare_shapes(cfg.dataset, cfg.sim, objects, cfg.progress)
     models = load_models(cfg, objects)
     results: list[TrialResult] = []
     with tqdm(

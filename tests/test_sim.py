@@ -9,7 +9,7 @@ from graspexp.planning.grasp import Grasp
 from graspexp.planning.request import PlanResult
 from graspexp.seeding import derive_seed
 from graspexp.sim import trial as trial_mod
-from graspexp.sim.collision import convex_hulls
+from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.contacts import GRIPPER_LINKS
 from graspexp.sim.outcome import FailureReason
 from graspexp.sim.scene import SUPPORT_NAME
@@ -38,7 +38,7 @@ def _ctx(*overrides, obj="can", trial=0, recorder=None):
     cfg = compose_cfg("dataset=primitives", *overrides)
     plain = plain_config(cfg)
     model = load_object(cfg.dataset, obj, cfg.planner.n_points, derive_seed(cfg.seed, "cloud", obj))
-    hulls = convex_hulls(model.mesh, plain.sim)
+    hulls = collision_shape(model.mesh, plain.sim)
     return TrialContext(plain, model, hulls, trial, trial_seed(plain, obj, trial), recorder or NullRecorder())
 
 

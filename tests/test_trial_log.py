@@ -13,7 +13,7 @@ from graspexp.datasets import load_object
 from graspexp.record import TrialRecorder, read_trial
 from graspexp.record.scene import object_scene
 from graspexp.seeding import derive_seed
-from graspexp.sim.collision import convex_hulls
+from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
 
 pytestmark = pytest.mark.sim
@@ -125,7 +125,7 @@ def collab_log(tmp_path_factory) -> Path:
     plain = plain_config(compose_cfg("mode=collab"))
     name = "can"
     model = load_object(plain.dataset, name, plain.planner.n_points, derive_seed(plain.seed, "cloud", name))
-    hulls = convex_hulls(model.mesh, plain.sim)
+    hulls = collision_shape(model.mesh, plain.sim)
     path = tmp_path_factory.mktemp("collab") / "000.mcap"
     with TrialRecorder(path, {"object": name}) as rec:
         ctx = TrialContext(

@@ -25,7 +25,7 @@ from graspexp.datasets import available_objects, load_object
 from graspexp.record import TrialRecorder
 from graspexp.record.scene import object_scene
 from graspexp.seeding import derive_seed
-from graspexp.sim.collision import convex_hulls
+from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial, trial_seed
 
 PHASES = ("build", "settle", "plan", "quality", "execute", "log")
@@ -61,7 +61,7 @@ class _Object:
         self.name = name
         seed = derive_seed(cfg.seed, "cloud", name)
         self.model = load_object(cfg.dataset, name, cfg.planner.n_points, seed)
-        self.hulls = convex_hulls(self.model.mesh, self.plain.sim)
+        self.hulls = collision_shape(self.model.mesh, self.plain.sim)
         self.scene = object_scene(self.plain, self.hulls)
 
     def trial(self, i: int, out: str | None) -> dict:

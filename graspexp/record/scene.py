@@ -24,7 +24,7 @@ from foxglove.messages import (
 
 from graspexp.config import JobConfig
 from graspexp.config.gripper import finger_z_range_m
-from graspexp.sim.collision import hull_meshes
+from graspexp.sim.collision_shapes import hull_meshes
 from graspexp.sim.gripper import FINGER_NAMES, PALM_NAME
 from graspexp.sim.scene import OBJECT_NAME, SUPPORT_NAME
 

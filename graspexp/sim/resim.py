@@ -6,7 +6,7 @@ from omegaconf import OmegaConf
 from graspexp.config.registry import job_config_from_yaml
 from graspexp.datasets import load_object
 from graspexp.seeding import derive_seed
-from graspexp.sim.collision import convex_hulls
+from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import NullRecorder, TrialContext, run_trial
 
 POSE_TOLERANCE = 1e-6
@@ -38,7 +38,9 @@ def resimulate(log) -> tuple[bool, str]:
     name, trial, seed = meta["object"], int(meta["trial"]), int(meta["trial_seed"])
     model = load_object(cfg.dataset, name, cfg.planner.n_points, derive_seed(cfg.seed, "cloud", name))
     capture = _PoseCapture()
-    result = run_trial(TrialContext(plain, model, convex_hulls(model.mesh, plain.sim), trial, seed, capture))
+    result = run_trial(
+        TrialContext(plain, model, collision_shape(model.mesh, plain.sim), trial, seed, capture)
+    )
     logged = log.result or {}
     problems = []
     if bool(logged.get("success")) != result.success or logged.get("reason") != result.reason:

@@ -1,7 +1,8 @@
 """A fresh physics-only SAPIEN scene per trial: the support and the dropped object.
 
 World frame: z up, metres. The support is a static box on the floor (z = 0) whose top is the plane
-z = h (``mode.support_height_m``); the floor touches the object only. Collision filtering uses SAPIEN's groups: two shapes collide when
+z = h (``mode.support_height_m``); the floor (a thin box: PhysX makes no contact between an SDF triangle
+mesh and a plane) touches the object only. Collision filtering uses SAPIEN's groups: two shapes collide when
 ``(A[0] & B[1]) or (A[1] & B[0])``; the bits below say what each body is and what it touches.
 """
 
@@ -12,9 +13,12 @@ import sapien
 
 from graspexp.config import ModeConfig, SimConfig
 from graspexp.geometry import matrix_to_quat_wxyz, quat_wxyz_to_matrix
+from graspexp.sim.collision_shapes import CollisionShape
 
 OBJECT_BIT, SUPPORT_BIT, GRIPPER_BIT, GROUND_BIT = 1, 2, 4, 8
 OBJECT_NAME, SUPPORT_NAME, GROUND_NAME = "object", "support", "ground"
+FLOOR_HALF_SIZE_M = (10.0, 10.0, 0.05)
+"""Half extents of the floor box whose top is z = 0, m (wide enough to catch anything that falls off)."""
 
 
 def configure_physx(cfg: SimConfig) -> None:
@@ -32,6 +36,9 @@ def configure_physx(cfg: SimConfig) -> None:
     )
     sapien.physx.set_shape_config(
         contact_offset=float(cfg.contact_offset_m), rest_offset=float(cfg.rest_offset_m)
+    )
+    sapien.physx.set_sdf_config(
+        spacing=float(cfg.sdf_spacing_m), subgrid_size=6, num_threads_for_construction=1
     )
 
 
@@ -66,7 +73,7 @@ class TrialScene:
 
 
 def build_scene(
-    hulls: list[np.ndarray],
+    shape: CollisionShape,
     mass_kg: float,
     drop_pose: np.ndarray,
     mode: ModeConfig,
@@ -74,7 +81,8 @@ def build_scene(
 ) -> TrialScene:
     """Create the scene with the support and the object at ``drop_pose`` ((4,4), world, m).
 
-    The object is one dynamic body with one convex shape per hull; its total mass is ``mass_kg``.
+    The object is one dynamic body with ``shape``'s collision parts (convex hulls, or one SDF triangle
+    mesh); its total mass is ``mass_kg``.
     In collab mode the support collides with the object only (paper IV-A); in bin mode also with the gripper.
     """
     configure_physx(sim)
@@ -84,7 +92,9 @@ def build_scene(
 
     support_mat = sapien.physx.PhysxMaterial(sim.support_friction, sim.support_friction, 0.0)
     ground = scene.create_actor_builder()  # the floor under the support: catches objects that fall off
-    ground.add_plane_collision(sapien.Pose(q=[0.7071068, 0.0, -0.7071068, 0.0]), material=support_mat)
+    ground.add_box_collision(
+        sapien.Pose([0.0, 0.0, -FLOOR_HALF_SIZE_M[2]]), half_size=FLOOR_HALF_SIZE_M, material=support_mat
+    )
     floor = ground.build_static(GROUND_NAME)
     set_groups(floor.find_component_by_type(sapien.physx.PhysxRigidStaticComponent), GROUND_BIT, OBJECT_BIT)
     builder = scene.create_actor_builder()
@@ -99,15 +109,13 @@ def build_scene(
 
     obj_mat = sapien.physx.PhysxMaterial(sim.object_static_friction, sim.object_dynamic_friction, 0.0)
     body = sapien.physx.PhysxRigidDynamicComponent()
-    for verts in hulls:
-        shape = sapien.physx.PhysxCollisionShapeConvexMesh(
-            vertices=verts, scale=[1.0, 1.0, 1.0], material=obj_mat
-        )
-        shape.set_density(1000.0)
-        body.attach(shape)
-    if len(body.get_collision_shapes()) != len(hulls):
+    for part in _object_shapes(shape, obj_mat):
+        part.set_density(1000.0)
+        body.attach(part)
+    if len(body.get_collision_shapes()) != len(shape.parts):
         raise RuntimeError(
-            f"PhysX dropped {len(hulls) - len(body.get_collision_shapes())} of {len(hulls)} hulls"
+            f"PhysX dropped {len(shape.parts) - len(body.get_collision_shapes())} of "
+            f"{len(shape.parts)} collision parts"
         )
     entity = sapien.Entity()
     entity.name = OBJECT_NAME
@@ -118,3 +126,17 @@ def build_scene(
     body.angular_damping = float(sim.object_angular_damping)
     set_groups(body, OBJECT_BIT, SUPPORT_BIT | GRIPPER_BIT | GROUND_BIT)
     return TrialScene(scene=scene, object_entity=entity, object_body=body, support=support, table_z=h)
+
+
+def _object_shapes(
+    shape: CollisionShape, material: sapien.physx.PhysxMaterial
+) -> list[sapien.physx.PhysxCollisionShape]:
+    """PhysX shapes of the object's collision parts (object frame, metres)."""
+    one = np.ones(3, dtype=np.float32)
+    if shape.convex:
+        return [
+            sapien.physx.PhysxCollisionShapeConvexMesh(vertices=v, scale=one, material=material)
+            for v, _ in shape.parts
+        ]
+    # from the file: SAPIEN cooks it (SDF included) once per process and reuses it
+    return [sapien.physx.PhysxCollisionShapeTriangleMesh(str(shape.mesh_file), one, material, sdf=True)]

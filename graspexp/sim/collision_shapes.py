@@ -1,0 +1,236 @@
+"""Object collision shapes, cached on disk by mesh content and parameters.
+
+Three methods (``sim.collision_method``):
+
+* ``mesh``: each sizeable part of the mesh repaired to a closed, manifold surface (MeshFix; scanned
+  meshes have holes and loose bits), decimated to ``sim.mesh_max_faces`` triangles, repaired again, and collided as one PhysX
+  triangle mesh with an SDF (PhysX simulates a dynamic triangle mesh only with an SDF). Supports and
+  floors must then be boxes: PhysX makes no contacts between such a mesh and a plane.
+* ``coacd`` / ``vhacd``: a convex decomposition (CoACD, or V-HACD through ``vhacdx``); one convex
+  PhysX shape per hull.
+
+The cache key is the SHA-256 of the mesh content (merged vertices and faces) and the method's
+parameters, so a changed mesh or parameter never reuses a stale shape. ``mesh`` also writes the mesh as
+an OBJ file beside the cache entry: SAPIEN cooks a mesh file once per process and reuses it.
+"""
+
+import hashlib
+import json
+import os
+import sys
+import tempfile
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import trimesh
+
+from graspexp.config import SimConfig
+
+METHODS = ("mesh", "coacd", "vhacd")
+
+
+@dataclass(frozen=True)
+class CollisionShape:
+    """An object's collision geometry in the object frame, metres."""
+
+    method: str
+    """The ``sim.collision_method`` it was made for (one of :data:`METHODS`)."""
+    parts: tuple[tuple[np.ndarray, np.ndarray], ...]
+    """(vertices (V, 3) float32, faces (F, 3) int64) per part: convex hulls, or one closed mesh."""
+    convex: bool
+    """True: every part is a convex hull (PhysX convex shapes). False: one closed triangle mesh."""
+    mesh_file: Path | None = None
+    """The OBJ file of the closed mesh that SAPIEN cooks once per process; None for hulls."""
+
+    def meshes(self) -> list[trimesh.Trimesh]:
+        """The parts as triangle meshes (object frame, metres)."""
+        return [trimesh.Trimesh(v, f, process=False) for v, f in self.parts]
+
+
+def cache_dir(cfg: SimConfig) -> Path:
+    """``sim.cache_dir``, else env ``GRASPEXP_CACHE``, else ``~/.cache/graspexp``; ``collision/`` below it."""
+    base = cfg.cache_dir or os.environ.get("GRASPEXP_CACHE") or Path.home() / ".cache" / "graspexp"
+    return Path(base) / "collision"
+
+
+def shape_params(cfg: SimConfig) -> dict:
+    """The method and its parameters from ``conf/sim`` (seeds fixed: every method is deterministic)."""
+    method = cfg.collision_method
+    if method == "mesh":
+        return {
+            "method": method,
+            "max_faces": int(cfg.mesh_max_faces),
+            "min_part_area": float(cfg.mesh_min_part_area),
+            "tolerance_m": float(cfg.mesh_tolerance_m),
+            "sdf_spacing_m": float(cfg.sdf_spacing_m),
+        }
+    if method == "coacd":
+        return {
+            "method": method,
+            "threshold": float(cfg.coacd_threshold),
+            "preprocess_resolution": int(cfg.coacd_preprocess_resolution),
+            "resolution": int(cfg.coacd_resolution),
+            "mcts_iterations": int(cfg.coacd_mcts_iterations),
+            "max_convex_hull": int(cfg.coacd_max_convex_hull),
+            "seed": 0,
+        }
+    if method == "vhacd":
+        return {
+            "method": method,
+            "maxConvexHulls": int(cfg.vhacd_max_hulls),
+            "resolution": int(cfg.vhacd_resolution),
+            "minimumVolumePercentErrorAllowed": float(cfg.vhacd_min_volume_error_pct),
+            "shrinkWrap": bool(cfg.vhacd_shrinkwrap),
+        }
+    raise ValueError(f"sim.collision_method={method!r} is invalid: expected one of {', '.join(METHODS)}")
+
+
+def mesh_key(mesh: trimesh.Trimesh, params: dict) -> str:
+    """Content hash of the mesh geometry and the shape parameters."""
+    h = hashlib.sha256()
+    h.update(np.ascontiguousarray(mesh.vertices, dtype=np.float64).tobytes())
+    h.update(np.ascontiguousarray(mesh.faces, dtype=np.int64).tobytes())
+    h.update(json.dumps(params, sort_keys=True).encode())
+    return h.hexdigest()[:32]
+
+
+def is_cached(mesh: trimesh.Trimesh, cfg: SimConfig) -> bool:
+    """Whether :func:`collision_shape` would read ``mesh``'s shape from the cache."""
+    params = shape_params(cfg)
+    return (cache_dir(cfg) / f"{mesh_key(mesh, params)}.npz").exists()
+
+
+def collision_shape(mesh: trimesh.Trimesh, cfg: SimConfig) -> CollisionShape:
+    """The collision shape of ``mesh`` (object frame, metres) for ``cfg.collision_method``: from the
+    cache, or built and cached. A mesh that is already convex (within 0.1 % of its hull volume) is its
+    own single hull under every method."""
+    params = shape_params(cfg)
+    path = cache_dir(cfg) / f"{mesh_key(mesh, params)}.npz"
+    if not path.exists():
+        convex, parts = _build(mesh, params)
+        arrays = {f"{kind}_{i}": a for i, (v, f) in enumerate(parts) for kind, a in (("v", v), ("f", f))}
+        _write_atomic(path, lambda fh: np.savez(fh, convex=convex, **arrays))
+    with np.load(path) as data:
+        convex = bool(data["convex"])
+        parts = tuple((data[f"v_{i}"], data[f"f_{i}"]) for i in range((len(data.files) - 1) // 2))
+    if convex:
+        return CollisionShape(params["method"], parts, True)
+    obj = path.with_suffix(".obj")  # OBJ: SAPIEN 3.0.3 crashes cooking some binary PLY files (16k faces)
+    if not obj.exists():
+        text = trimesh.Trimesh(*parts[0], process=False).export(file_type="obj", include_normals=False)
+        _write_atomic(obj, lambda fh: fh.write(text.encode()))
+    return CollisionShape(params["method"], parts, False, obj)
+
+
+def _build(mesh: trimesh.Trimesh, params: dict) -> tuple[bool, list[tuple[np.ndarray, np.ndarray]]]:
+    """(convex, parts) for ``mesh`` under ``params`` (see :func:`collision_shape`)."""
+    hull = mesh.convex_hull
+    if mesh.is_volume and abs(hull.volume - mesh.volume) <= 1e-3 * hull.volume:
+        return True, [_part(hull.vertices, hull.faces)]
+    method = params["method"]
+    if method == "mesh":
+        return False, [_closed_mesh(mesh, params)]
+    if method == "coacd":
+        import coacd
+
+        coacd.set_log_level("error")
+        kw = {k: v for k, v in params.items() if k != "method"}
+        raw = coacd.run_coacd(coacd.Mesh(np.asarray(mesh.vertices), np.asarray(mesh.faces)), **kw)
+    else:
+        import vhacdx
+
+        kw = {k: v for k, v in params.items() if k != "method"}
+        raw = vhacdx.compute_vhacd(np.asarray(mesh.vertices), np.asarray(mesh.faces, dtype=np.uint32), **kw)
+    parts = [_part(v, f) for v, f in raw]
+    if not parts:
+        raise ValueError(f"convex decomposition of the mesh returned no hull (params {params})")
+    return True, parts
+
+
+def _part(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return np.asarray(vertices, dtype=np.float32), np.asarray(faces, dtype=np.int64)
+
+
+def _closed_mesh(mesh: trimesh.Trimesh, params: dict) -> tuple[np.ndarray, np.ndarray]:
+    """``mesh`` as closed manifold shells, checked against ``mesh``.
+
+    Each connected component with at least ``min_part_area`` of the mesh's area (smaller ones are scan
+    debris) is repaired by MeshFix, decimated to its share (by area) of the face budget and repaired
+    again. Decimation can collapse a thin wall, so the result is measured: if the 90th percentile of
+    its surface outside the mesh, or of the mesh outside it, exceeds ``tolerance_m``, the budget doubles
+    (from ``max_faces`` up to no decimation). Returns the shells in one (vertices, faces) pair.
+    """
+    from graspexp.sim.collision_accuracy import signed_distance_m
+
+    kept = [c for c in mesh.split(only_watertight=False) if c.area >= params["min_part_area"] * mesh.area]
+    area = sum(c.area for c in kept)
+    mesh_pts, _ = trimesh.sample.sample_surface(mesh, 2000, seed=0)
+    budget = params["max_faces"]
+    while True:
+        shells = [_closed_shell(c, max(int(budget * c.area / area), 64)) for c in kept]
+        joined = trimesh.util.concatenate(shells)
+        own_pts, _ = trimesh.sample.sample_surface(joined, 2000, seed=0)
+        out = np.percentile(np.maximum(signed_distance_m(own_pts, mesh), 0.0), 90)
+        gap = np.percentile(
+            np.maximum(np.min([signed_distance_m(mesh_pts, s) for s in shells], axis=0), 0.0), 90
+        )
+        if max(out, gap) <= params["tolerance_m"] or budget >= len(mesh.faces):
+            return _part(joined.vertices, joined.faces)
+        budget *= 2
+
+
+def _closed_shell(component: trimesh.Trimesh, budget: int) -> trimesh.Trimesh:
+    """One component repaired by MeshFix, decimated to ``budget`` faces and repaired again."""
+    import pymeshfix
+
+    with _quiet_stdio():  # MeshFix prints "could not fix everything" from C for shells it did close
+        v, f = pymeshfix.clean_from_arrays(
+            np.asarray(component.vertices), np.asarray(component.faces, dtype=np.int32)
+        )
+        if len(f) > budget:
+            small = trimesh.Trimesh(v, f, process=False).simplify_quadric_decimation(face_count=budget)
+            v, f = pymeshfix.clean_from_arrays(
+                np.asarray(small.vertices), np.asarray(small.faces, dtype=np.int32)
+            )
+    shell = trimesh.Trimesh(v, f, process=False)
+    if not shell.is_watertight or shell.volume <= 0:
+        raise ValueError(
+            "a part of the mesh could not be repaired into a closed surface for sim.collision_method=mesh "
+            f"(after MeshFix: {len(f)} faces, watertight={shell.is_watertight}); "
+            "use sim.collision_method=coacd for this object"
+        )
+    return shell
+
+
+@contextmanager
+def _quiet_stdio():
+    """Silence the C-level stdout and stderr of a library call (Python's streams are flushed first)."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+        os.dup2(devnull, 2)
+        yield
+    finally:
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for fd in (*saved, devnull):
+            os.close(fd)
+
+
+def _write_atomic(path: Path, write) -> None:
+    """Write ``path`` through a temporary file in the same folder (readers never see a partial file)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=path.suffix + ".partial")
+    with os.fdopen(fd, "wb") as fh:
+        write(fh)
+    os.replace(tmp, path)
+
+
+def hull_meshes(shape: CollisionShape) -> list[trimesh.Trimesh]:
+    """Triangle meshes of the collision parts (for the MCAP scene), object frame, metres."""
+    return shape.meshes()
