@@ -24,7 +24,7 @@ from graspexp.report.render import markdown  # noqa: E402
 
 SETTING_KEYS = ["dataset", "planner", "mode", "rot"]
 VIEW_HALF_M = 0.13
-"""Half the side of the cube drawn around the object, m."""
+"""Half the side of the cube drawn around the planned grasp point, m."""
 AXIS_LEN_M = 0.04
 """Length of the drawn grasp-frame axes, m."""
 CUBE_FACES = np.array([[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]])
@@ -123,7 +123,8 @@ def draw_trial(log: TrialLog, path: Path, title: str) -> Path:
     for j, (label, t_s) in enumerate(times.items()):
         ax = fig.add_subplot(1, 2, j + 1, projection="3d")
         obj = _pose_at(log, "object", t_s)
-        centre = obj[:3, 3] if obj is not None else np.zeros(3)
+        # Centred on the planned grasp point (where failures happen), else on the object's origin.
+        centre = grasp[:3, 3] if grasp is not None else obj[:3, 3] if obj is not None else np.zeros(3)
         polys = _polygons(log, t_s, centre)
         if polys:
             coll = Poly3DCollection([p for p, _ in polys], facecolors=[c for _, c in polys], linewidths=0.1)
