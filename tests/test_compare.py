@@ -7,9 +7,9 @@ import pytest
 
 from graspexp.compare import check_same_drops, collect_trials, write_report
 from graspexp.compare.__main__ import main
+from graspexp.outcome import TrialResult
 from graspexp.record import TrialRecorder
 from graspexp.report.stats import wilson_interval
-from graspexp.sim.outcome import TrialResult
 
 
 def _log(run_dir, planner, obj, trial, seed, success, trans_mm=0.0, rot_deg=0.0, mode="bin") -> None:

@@ -15,6 +15,7 @@ from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory
 
 from graspexp.geometry import axis_angle_matrix, matrix_to_quat_wxyz
+from graspexp.outcome import FailureReason, TrialResult
 from graspexp.record import (
     CorruptLogError,
     OldLogFormatError,
@@ -26,7 +27,6 @@ from graspexp.record import (
 )
 from graspexp.record import schemas as S
 from graspexp.record.scene import box_entity, mesh_entity
-from graspexp.sim.outcome import FailureReason, TrialResult
 
 METADATA = {"config": "planner:\n  name: paper\n", "seed": "7", "versions": "graspexp=0.1.0"}
 RATE_HZ = 30

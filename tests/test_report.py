@@ -6,12 +6,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from graspexp.outcome import FailureReason, TrialResult
 from graspexp.record import TrialRecorder
 from graspexp.report import build_report, collect, wilson_interval, write_report
 from graspexp.report.__main__ import main as report_main
 from graspexp.report.paper import BASELINES, SETTINGS, TABLE1, TABLE2
 from graspexp.report.render import display_frame, latex_escape
-from graspexp.sim.outcome import FailureReason, TrialResult
 from tests.conftest import compose_cfg
 
 # ---------------------------------------------------------------- Wilson interval (hand-computed)

@@ -13,9 +13,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from graspexp.outcome import FailureReason, TrialResult
 from graspexp.record import TrialRecorder, read_result
 from graspexp.runner import config_differences, job_lock, job_metadata, summarize
-from graspexp.sim.outcome import FailureReason, TrialResult
 from tests.conftest import compose_cfg
 
 REPO = Path(__file__).resolve().parent.parent

@@ -2,8 +2,6 @@
 
 from pathlib import Path
 
-from hydra.core.config_store import ConfigStore
-
 from graspexp.config.dataset import DatasetConfig
 from graspexp.config.gripper import GripperConfig
 from graspexp.config.job import JobConfig
@@ -33,6 +31,8 @@ def group_options(group: str) -> list[str]:
 
 def register_configs() -> None:
     """Store ``base_job`` and one ``base_<group>`` schema per group; safe to call twice."""
+    from hydra.core.config_store import ConfigStore  # here, so that the schemas load without Hydra
+
     cs = ConfigStore.instance()
     cs.store(name="base_job", node=JobConfig)
     for group, schema in SCHEMAS.items():
