@@ -7,6 +7,7 @@ from collections.abc import Callable
 from omegaconf import DictConfig
 
 from graspexp.config import ConfigError, register_configs, validate
+from graspexp.config.plugins import PluginError, load_planners
 from graspexp.config.registry import CONF_DIR
 
 _VALUE_FLAGS = {
@@ -90,11 +91,16 @@ def check_overrides(overrides: list[str], config_name: str = "config") -> None:
 
     mine = [o for o in overrides if not o.lstrip("+~").startswith("hydra")]
     try:
+        for o in mine:  # a broken planner plugin: its own error (naming the package), not "not found"
+            if o.startswith("planner="):
+                for name in o.split("=", 1)[1].split(","):
+                    if isinstance(load_planners().get(name), PluginError):
+                        raise load_planners()[name]
         parsed = OverridesParser.create().parse_overrides(mine)
         for batch in BasicSweeper.split_arguments(parsed, None):
             for combo in batch:
                 validate(compose_config(combo, config_name))
-    except ConfigError as exc:
+    except (ConfigError, PluginError) as exc:
         fail(str(exc))
     except Exception as exc:  # Hydra/OmegaConf errors: report the reason, not the traceback
         fail(_one_line(exc))

@@ -282,8 +282,12 @@ def run_job(cfg: DictConfig) -> float:
     """Run every trial for every selected object; returns the overall success rate in [0, 1]."""
     from hydra.core.hydra_config import HydraConfig
 
+    return run_in_dir(cfg, Path(HydraConfig.get().runtime.output_dir))
+
+
+def run_in_dir(cfg: DictConfig, run_dir: Path) -> float:
+    """:func:`run_job` into ``run_dir`` (resumable, locked), outside a Hydra run (e.g. the benchmark)."""
     validate(cfg)
-    run_dir = Path(HydraConfig.get().runtime.output_dir)
     with job_lock(run_dir), threadpool_limits(limits=1):  # trials are sequential: one core per job
         return _run(cfg, run_dir)
 

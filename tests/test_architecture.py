@@ -16,8 +16,6 @@ STAGE_OF_PACKAGE = {**{s: s for s in STAGES}, "quality": "planning", "compare": 
 """Packages that belong to a stage without carrying its name (grasp quality is a planning-side check)."""
 BASE_MODULES = {"graspexp", "graspexp.geometry", "graspexp.seeding", "graspexp.outcome"}
 """Modules every stage may import: they import no stage themselves."""
-KNOWN_BACK_EDGES = {("graspexp.config.validate", "graspexp.planning.registry")}
-"""Back edges another change removes (issue 13: planner names from the registry); delete when it lands."""
 
 
 def _module_name(path: Path) -> str:
@@ -70,8 +68,6 @@ def test_stages_import_one_way():
     for module, deps in graph.items():
         stage = _stage(module)
         for dep in deps:
-            if (module, dep) in KNOWN_BACK_EDGES:
-                continue
             dep_stage = _stage(dep)
             if module in BASE_MODULES and dep not in BASE_MODULES:
                 wrong.append(f"{module} (base) imports {dep}")
@@ -89,8 +85,6 @@ def test_stages_import_one_way():
 def test_no_import_cycle():
     """No cycle between modules (a package counts as importing its __init__'s imports)."""
     graph = _graph()
-    for a, b in KNOWN_BACK_EDGES:
-        graph[a].discard(b)
     state: dict[str, int] = {}
     stack: list[str] = []
 

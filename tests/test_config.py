@@ -6,10 +6,13 @@ import sys
 from pathlib import Path
 
 import pytest
+from omegaconf import OmegaConf
 
 from graspexp.cli import CONF_DIR, split_argv
-from graspexp.config import ConfigError, sim, validate
+from graspexp.config import AntipodalConfig, ConfigError, JobConfig, OptimalConfig, sim, validate
 from graspexp.config.constraints import accepts, describe
+from graspexp.config.plugins import load_planners
+from graspexp.config.registry import group_options
 from graspexp.config.validate import NOT_CONFIG, SCHEMA_CONSTRAINTS
 from tests.conftest import compose_cfg
 
@@ -157,7 +160,30 @@ def test_split_argv_drops_flags_and_their_values():
 def test_every_key_of_every_schema_has_a_constraint():
     for schema, constraints in SCHEMA_CONSTRAINTS.items():
         keys = {f.name for f in dataclasses.fields(schema) if not dataclasses.is_dataclass(f.type)}
-        assert keys - NOT_CONFIG == set(constraints), schema.__name__
+        planner = {"planner"} if schema is JobConfig else set()  # checked against the planner's own schema
+        assert keys - NOT_CONFIG - planner == set(constraints), schema.__name__
+    for name, found in load_planners().items():
+        assert {f.name for f in dataclasses.fields(found.plugin.config)} == set(found.plugin.constraints), (
+            name
+        )
+
+
+def test_each_planner_has_its_own_schema_and_the_names_come_from_the_registry():
+    assert group_options("planner") == sorted(load_planners())
+    assert type(OmegaConf.to_object(compose_cfg("planner=antipodal").planner)) is AntipodalConfig
+    assert type(OmegaConf.to_object(compose_cfg("planner=optimal_literal").planner)) is OptimalConfig
+    with pytest.raises(
+        ConfigError, match="^planner.seed=1 is invalid: 'seed' is not a key of group 'planner'"
+    ):
+        validate(compose_cfg("planner=antipodal", "+planner.seed=1"))  # it would be ignored
+    with pytest.raises(
+        ConfigError, match=r"^planner.name has no value: planner=base_<planner> is the schema"
+    ):
+        validate(compose_cfg("planner=base_optimal"))
+    with pytest.raises(
+        ConfigError, match=r"^planner.name='nope' is unknown: expected one of antipodal, obb,"
+    ):
+        validate(compose_cfg("planner.name=nope"))
 
 
 def test_optional_slip_threshold_accepts_null_and_positive_values_only():

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from graspexp.config import CostConfig, GripperConfig, PlannerConfig
+from graspexp.config import CostConfig, GripperConfig, OptimalConfig
 from graspexp.planning import PlanRequest
 
 RG2 = GripperConfig(
@@ -45,7 +45,7 @@ def request(
     mode: str = "collab",
     seed: int = 0,
     gripper: GripperConfig = RG2,
-    planner: PlannerConfig | None = None,
+    planner: OptimalConfig | None = None,
     cost: CostConfig | None = None,
 ) -> PlanRequest:
     return PlanRequest(
@@ -56,7 +56,7 @@ def request(
         table_z=table_z,
         mode=mode,
         gripper=gripper,
-        planner=planner if planner is not None else PlannerConfig(name="optimal", m=128),
+        planner=planner if planner is not None else OptimalConfig(name="optimal", m=128),
         cost=cost if cost is not None else CostConfig(),
         seed=seed,
     )

@@ -11,7 +11,7 @@ from test_planner_common import RG2
 
 import graspexp.planning.optimal as optimal
 from graspexp.cli import compose_config
-from graspexp.config import CostConfig, DatasetConfig, PlannerConfig
+from graspexp.config import CostConfig, DatasetConfig, OptimalConfig
 from graspexp.config.gripper import finger_z_range_m
 from graspexp.datasets import load_object
 from graspexp.datasets.catalog import candidate_paths
@@ -198,7 +198,7 @@ def test_compiled_plan_matches_the_numpy_reference_on_every_real_object(data_roo
                 table_z=support_z,
                 mode=mode,
                 gripper=RG2,
-                planner=PlannerConfig(name="optimal"),
+                planner=OptimalConfig(name="optimal"),
                 cost=COST,
                 seed=1,
             )

@@ -8,9 +8,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from test_planner_common import RG2, box_cloud, cylinder_cloud, request
 
-from graspexp.config import PlannerConfig
+from graspexp.config import OptimalConfig
 from graspexp.geometry import quat_wxyz_to_matrix
-from graspexp.planning import PLANNERS, NoFeasibleGrasp, UnknownPlanner, get_planner, plan, plan_optimal
+from graspexp.planning import NoFeasibleGrasp, UnknownPlanner, get_planner, plan, plan_optimal
 
 DETAIL_KEYS = {
     "cloud",
@@ -127,13 +127,13 @@ def test_k_auto_follows_the_area_length_and_the_gripper():
     assert expected == 2
     res = plan_optimal(request(pts, mask))
     assert res.grasp.extras["K"] == expected
-    half = PlannerConfig(name="optimal", auto_k_stroke_fraction=0.5)
+    half = OptimalConfig(name="optimal", auto_k_stroke_fraction=0.5)
     assert plan_optimal(request(pts, mask, planner=half)).grasp.extras["K"] == 4
     wide = dataclasses.replace(RG2, max_width_m=0.5)
     assert plan_optimal(request(pts, mask, gripper=wide)).grasp.extras["K"] == 1
-    capped = PlannerConfig(name="optimal", m=64, k_max=2)
+    capped = OptimalConfig(name="optimal", m=64, k_max=2)
     assert plan_optimal(request(pts, mask, planner=capped)).grasp.extras["K"] == 2
-    fixed = PlannerConfig(name="optimal", m=64, k=3)
+    fixed = OptimalConfig(name="optimal", m=64, k=3)
     assert plan_optimal(request(pts, mask, planner=fixed)).details["centers"].shape == (3, 3)
 
 
@@ -147,7 +147,7 @@ def test_every_path_through_the_table_raises():
     pts, mask = _upright_cylinder(table_z=0.0)
     with pytest.raises(NoFeasibleGrasp, match="below the support plane"):
         plan_optimal(request(pts, mask, table_z=0.5))  # the plane is far above the object
-    clearance = PlannerConfig(name="optimal", m=64, table_clearance_m=0.3)
+    clearance = OptimalConfig(name="optimal", m=64, table_clearance_m=0.3)
     with pytest.raises(NoFeasibleGrasp, match="below the support plane"):
         plan_optimal(request(pts, mask, table_z=0.0, planner=clearance))
 
@@ -156,7 +156,7 @@ def test_object_wider_than_the_gripper_raises():
     rng = np.random.default_rng(6)
     u = rng.normal(size=(1500, 3))
     ball = 0.1 * u / np.linalg.norm(u, axis=1, keepdims=True)  # 200 mm ball: every section > 110 mm
-    one = PlannerConfig(name="optimal", m=64, k=1)
+    one = OptimalConfig(name="optimal", m=64, k=1)
     with pytest.raises(NoFeasibleGrasp, match="wider than the gripper"):
         plan_optimal(request(ball, np.ones(len(ball), dtype=bool), table_z=-1.0, planner=one))
     big = dataclasses.replace(RG2, max_width_m=0.25)
@@ -186,7 +186,7 @@ def test_a_band_shorter_than_its_diameter_is_closed_across_not_along_its_height(
     rng = np.random.default_rng(8)
     pts = cylinder_cloud(rng, 2048, radius_m=0.033, height_m=0.10) + [0.0, 0.0, 0.1]
     mask = (pts[:, 2] > 0.13) & (pts[:, 2] < 0.17)
-    area_axes = PlannerConfig(
+    area_axes = OptimalConfig(
         name="optimal", main_axis="area", pose_axis="area", cluster_radius="rms", auto_k_stroke_fraction=0.5
     )
     req = request(pts, mask, table_z=0.1, planner=area_axes)
@@ -204,7 +204,7 @@ def test_object_main_axis_of_a_can_is_its_height():
     rng = np.random.default_rng(8)
     pts = cylinder_cloud(rng, 2048, radius_m=0.033, height_m=0.10) + [0.0, 0.0, 0.1]
     mask = (pts[:, 2] > 0.13) & (pts[:, 2] < 0.17)
-    res = plan_optimal(request(pts, mask, table_z=0.1, planner=PlannerConfig(name="optimal")))
+    res = plan_optimal(request(pts, mask, table_z=0.1, planner=OptimalConfig(name="optimal")))
     assert abs(res.details["main_axis"][2]) > 0.95
     assert abs(res.grasp.pose[2, 1]) < 0.3
 
@@ -216,7 +216,7 @@ def test_opening_is_widened_when_no_section_fits_the_cluster_radius():
         (np.abs(pts[:, 0] - 0.03) < 1e-9) & (np.abs(pts[:, 1]) < 0.004) & (np.abs(pts[:, 2] - 0.03) < 0.004)
     )
     assert 0 < mask.sum() < 30  # a tiny patch: r_k of a few mm, opening far below any section
-    req = request(pts, mask, table_z=-1.0, planner=PlannerConfig(name="optimal", m=64))
+    req = request(pts, mask, table_z=-1.0, planner=OptimalConfig(name="optimal", m=64))
     res = plan_optimal(req)
     _check_result(res, req)
     g = res.grasp
@@ -226,14 +226,14 @@ def test_opening_is_widened_when_no_section_fits_the_cluster_radius():
 
 
 def test_registry_dispatches_and_lists_names():
-    assert PLANNERS["optimal"] is plan_optimal
+    assert get_planner("optimal_literal") is plan_optimal  # the same function under a second preset
     assert get_planner("optimal") is plan_optimal
     with pytest.raises(UnknownPlanner, match="planner.name='nope' is unknown: expected one of .*optimal"):
         get_planner("nope")
     pts, mask = _upright_cylinder()
     req = request(pts, mask, table_z=0.1)
     assert plan(req).grasp.pose.tobytes() == plan_optimal(req).grasp.pose.tobytes()
-    other = dataclasses.replace(req, planner=PlannerConfig(name="missing"))
+    other = dataclasses.replace(req, planner=OptimalConfig(name="missing"))
     with pytest.raises(UnknownPlanner, match="missing"):
         plan(other)
 
@@ -281,7 +281,7 @@ def test_property_valid_grasp_for_random_clouds_and_poses(
     mask = (proj >= lo) & (proj <= hi)
     mask[int(np.argmin(np.abs(proj - (lo + hi) / 2)))] = True
     req = request(
-        world, mask, table_z=table_z, mode=mode, seed=seed % 1000, planner=PlannerConfig(name="optimal", m=64)
+        world, mask, table_z=table_z, mode=mode, seed=seed % 1000, planner=OptimalConfig(name="optimal", m=64)
     )
     res = plan_optimal(req)
     _check_result(res, req)

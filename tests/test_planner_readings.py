@@ -6,7 +6,7 @@ from conftest import compose_cfg
 from omegaconf import OmegaConf
 from test_planner_common import RG2, cylinder_cloud, request
 
-from graspexp.config import PlannerConfig
+from graspexp.config import OptimalConfig
 from graspexp.planning import plan_optimal
 from graspexp.planning.clusters import main_axis
 
@@ -20,7 +20,7 @@ def _can_with_band(seed: int = 3):
 
 def _plan(**keys):
     pts, mask = _can_with_band()
-    return plan_optimal(request(pts, mask, table_z=0.1, planner=PlannerConfig(name="optimal", **keys)))
+    return plan_optimal(request(pts, mask, table_z=0.1, planner=OptimalConfig(name="optimal", **keys)))
 
 
 def test_cluster_radius_max_is_the_farthest_member_and_sets_the_opening():

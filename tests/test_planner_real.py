@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from test_planner_common import RG2
 
-from graspexp.config import CostConfig, DatasetConfig, PlannerConfig
+from graspexp.config import CostConfig, DatasetConfig, OptimalConfig
 from graspexp.datasets import load_object
 from graspexp.datasets.catalog import candidate_paths, dataset_spec
 from graspexp.plan import main as plan_main
@@ -43,7 +43,7 @@ def test_plan_every_real_object_in_both_modes(data_root, dataset):
                 table_z=support_z,
                 mode=mode,
                 gripper=RG2,
-                planner=PlannerConfig(name="optimal"),
+                planner=OptimalConfig(name="optimal"),
                 cost=CostConfig(),
                 seed=1,
             )

@@ -1,20 +1,39 @@
 """Structured Hydra configs: one schema dataclass per config group, registered in the ConfigStore.
 
-Every YAML option under ``conf/<group>/`` lists its schema (``base_<group>``) first in its defaults,
-so Hydra type-checks every option and rejects unknown keys.
+Every YAML option under ``conf/<group>/`` lists its schema (``base_<group>``; for a planner
+``base_<planner name>``, from its plugin) first in its defaults, so Hydra type-checks every option and
+rejects unknown keys. Nothing here imports Hydra (only :func:`register_configs` does, when called).
 """
 
+from graspexp.config.cost import CostConfig
 from graspexp.config.dataset import DatasetConfig
 from graspexp.config.gripper import GripperConfig
 from graspexp.config.job import JobConfig, PerceptionConfig, PoseNoiseConfig
 from graspexp.config.mode import ModeConfig
-from graspexp.config.planner import CostConfig, PlannerConfig
+from graspexp.config.planner import (
+    BASE_CONSTRAINTS,
+    AntipodalConfig,
+    ObbConfig,
+    OptimalConfig,
+    OptimalPlusConfig,
+    PlannerConfig,
+    RandomConfig,
+)
+from graspexp.config.plugins import PlannerPlugin, PluginError
 from graspexp.config.registry import register_configs
 from graspexp.config.rot import RotConfig
 from graspexp.config.sim import SimConfig
 from graspexp.config.validate import ConfigError, validate
 
 __all__ = [
+    "BASE_CONSTRAINTS",
+    "AntipodalConfig",
+    "ObbConfig",
+    "OptimalConfig",
+    "OptimalPlusConfig",
+    "PlannerPlugin",
+    "PluginError",
+    "RandomConfig",
     "ConfigError",
     "CostConfig",
     "DatasetConfig",

@@ -6,10 +6,10 @@ from typing import Any
 from omegaconf import MISSING
 
 from graspexp.config.constraints import BOOL, Interval, Names
+from graspexp.config.cost import CostConfig
 from graspexp.config.dataset import DatasetConfig
 from graspexp.config.gripper import GripperConfig
 from graspexp.config.mode import ModeConfig
-from graspexp.config.planner import CostConfig, PlannerConfig
 from graspexp.config.rot import RotConfig
 from graspexp.config.sim import SimConfig
 
@@ -34,7 +34,8 @@ class JobConfig:
     mode: ModeConfig = MISSING
     rot: RotConfig = MISSING
     gripper: GripperConfig = MISSING
-    planner: PlannerConfig = MISSING
+    planner: Any = MISSING
+    """The selected planner's own schema (a :class:`graspexp.config.PlannerConfig` subclass, from its plugin)."""
     cost: CostConfig = MISSING
     sim: SimConfig = MISSING
     perception: PerceptionConfig = field(default_factory=PerceptionConfig)

@@ -1,12 +1,15 @@
-"""Registers every schema in Hydra's ConfigStore (``base_<group>`` in each group)."""
+"""Registers every schema in Hydra's ConfigStore (``base_<group>`` in each group; one schema per planner)."""
 
 from pathlib import Path
 
+from omegaconf import DictConfig, OmegaConf
+
+from graspexp.config.cost import CostConfig
 from graspexp.config.dataset import DatasetConfig
 from graspexp.config.gripper import GripperConfig
 from graspexp.config.job import JobConfig
 from graspexp.config.mode import ModeConfig
-from graspexp.config.planner import CostConfig, PlannerConfig
+from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
 from graspexp.config.rot import RotConfig
 from graspexp.config.sim import SimConfig
 
@@ -14,26 +17,54 @@ SCHEMAS = {
     "dataset": DatasetConfig,
     "gripper": GripperConfig,
     "mode": ModeConfig,
-    "planner": PlannerConfig,
     "cost": CostConfig,
     "rot": RotConfig,
     "sim": SimConfig,
 }
+"""The schema of each group with one schema; the ``planner`` group has one per planner (its plugin's)."""
 
 CONF_DIR = str(Path(__file__).resolve().parent.parent.parent / "conf")
 """The YAML config tree (``conf/<group>/<option>.yaml``)."""
 
 
+def _yaml_options(group: str) -> set[str]:
+    return {p.stem for p in (Path(CONF_DIR) / group).glob("*.yaml")}
+
+
 def group_options(group: str) -> list[str]:
-    """The option names of config group ``group`` (its YAML files), sorted."""
-    return sorted(p.stem for p in (Path(CONF_DIR) / group).glob("*.yaml"))
+    """The option names of config group ``group``, sorted: its YAML files, and for ``planner`` also every
+    installed planner (a plugin without a preset file is an option with its schema's defaults)."""
+    names = _yaml_options(group)
+    if group == "planner":
+        names |= set(load_planners())
+    return sorted(names)
 
 
 def register_configs() -> None:
-    """Store ``base_job`` and one ``base_<group>`` schema per group; safe to call twice."""
+    """Store ``base_job``, one ``base_<group>`` schema per group, and per installed planner its schema as
+    ``planner/base_<name>`` plus, unless ``conf/planner/<name>.yaml`` is its preset, the option
+    ``planner/<name>`` (the schema's defaults); safe to call twice. Broken plugins are skipped here (their
+    error is raised when one is selected, see :func:`graspexp.config.plugins.get_plugin`)."""
     from hydra.core.config_store import ConfigStore  # here, so that the schemas load without Hydra
 
     cs = ConfigStore.instance()
     cs.store(name="base_job", node=JobConfig)
     for group, schema in SCHEMAS.items():
         cs.store(group=group, name=f"base_{group}", node=schema)
+    presets = _yaml_options("planner")
+    for name, found in load_planners().items():
+        if isinstance(found, LoadedPlanner):
+            schema = found.plugin.config
+            cs.store(group="planner", name=f"base_{name}", node=schema)
+            if name not in presets:
+                cs.store(group="planner", name=name, node=schema(name=name))
+
+
+def job_config_from_yaml(text: str) -> DictConfig:
+    """A job config recorded as YAML (e.g. a trial log's ``config_yaml``) typed again by its schemas, the
+    ``planner`` node by the schema of the planner it names (:class:`PluginError` if none is installed)."""
+    data = OmegaConf.create(text)
+    planner = OmegaConf.structured(get_plugin(data.planner.name).plugin.config)
+    cfg = OmegaConf.merge(OmegaConf.structured(JobConfig), data)
+    cfg.planner = OmegaConf.merge(planner, data.planner)
+    return cfg

@@ -12,8 +12,9 @@ from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
-from graspexp.config import dataset, gripper, job, mode, planner, rot, sim
+from graspexp.config import cost, dataset, gripper, job, mode, rot, sim
 from graspexp.config.constraints import accepts, describe
+from graspexp.config.plugins import PluginError, get_plugin
 from graspexp.config.registry import SCHEMAS, group_options
 
 
@@ -28,12 +29,12 @@ SCHEMA_CONSTRAINTS: dict[type, dict[str, list]] = {
     dataset.DatasetConfig: dataset.CONSTRAINTS,
     gripper.GripperConfig: gripper.CONSTRAINTS,
     mode.ModeConfig: mode.CONSTRAINTS,
-    planner.PlannerConfig: planner.PLANNER_CONSTRAINTS,
-    planner.CostConfig: planner.COST_CONSTRAINTS,
+    cost.CostConfig: cost.CONSTRAINTS,
     rot.RotConfig: rot.CONSTRAINTS,
     sim.SimConfig: sim.CONSTRAINTS,
 }
-"""Each schema's constraints mapping (field name -> allowed alternatives)."""
+"""Each schema's constraints mapping (field name -> allowed alternatives); a planner's schema and
+constraints come from its plugin (:func:`graspexp.config.plugins.get_plugin`)."""
 NOT_CONFIG = frozenset({"defaults"})
 """JobConfig fields that are Hydra's composition machinery, not settings."""
 RELATIONS = (
@@ -48,9 +49,9 @@ def _fields(schema: type) -> dict[str, dataclasses.Field]:
     return {f.name: f for f in dataclasses.fields(schema) if f.name not in NOT_CONFIG}
 
 
-def _check_node(node: DictConfig, schema: type, prefix: str) -> None:
+def _check_node(node: DictConfig, schema: type, prefix: str, constraints: dict | None = None) -> None:
     fields = _fields(schema)
-    constraints = SCHEMA_CONSTRAINTS[schema]
+    constraints = SCHEMA_CONSTRAINTS[schema] if constraints is None else constraints
     for key in node.keys():
         if key not in fields and key not in NOT_CONFIG:
             value = OmegaConf.select(node, str(key), throw_on_missing=False)
@@ -64,6 +65,9 @@ def _check_node(node: DictConfig, schema: type, prefix: str) -> None:
         if OmegaConf.is_missing(node, name):
             _missing(dotted)
         value = node[name]
+        if schema is job.JobConfig and name == "planner":
+            _check_planner(value)
+            continue
         if dataclasses.is_dataclass(field.type):
             _check_node(value, field.type, dotted + ".")
             continue
@@ -72,11 +76,22 @@ def _check_node(node: DictConfig, schema: type, prefix: str) -> None:
             raise ConfigError(f"{dotted}={plain!r} is invalid: expected {describe(constraints[name])}")
 
 
+def _check_planner(node: DictConfig) -> None:
+    """The ``planner`` node against the schema and constraints of the planner it names."""
+    if OmegaConf.is_missing(node, "name"):
+        _missing("planner.name")
+    try:
+        found = get_plugin(node.name)
+    except PluginError as exc:
+        raise ConfigError(str(exc)) from None
+    _check_node(node, found.plugin.config, "planner.", dict(found.plugin.constraints))
+
+
 def _missing(dotted: str) -> None:
     group = dotted.split(".")[0]
-    if group in SCHEMAS:
+    if group in SCHEMAS or group == "planner":
         raise ConfigError(
-            f"{group}.{dotted.split('.', 1)[-1]} has no value: {group}=base_{group} is the schema, not an "
+            f"{group}.{dotted.split('.', 1)[-1]} has no value: {group}=base_{'<planner>' if group == 'planner' else group} is the schema, not an "
             f"option; expected {group}= one of {', '.join(group_options(group))}"
         )
     raise ConfigError(f"{dotted} has no value: set it with {dotted}=...")
@@ -93,8 +108,3 @@ def validate(cfg: DictConfig | Any) -> None:
     """Raise :class:`ConfigError` naming the first dotted key whose value is unknown, missing or invalid."""
     _check_node(cfg, job.JobConfig, "")
     _check_relations(cfg)
-    from graspexp.planning.registry import PLANNERS
-
-    name = cfg.planner.name
-    if name not in PLANNERS:
-        raise ConfigError(f"planner.name={name!r} is invalid: expected one of {', '.join(sorted(PLANNERS))}")

@@ -1,23 +1,23 @@
 """Grasp planning: pure numpy, no simulator import.
 
-``plan(req)`` dispatches on ``req.planner.name`` through :data:`PLANNERS`; ``optimal`` is the paper's
-strategy (section III, :mod:`graspexp.planning.optimal`).
+``plan(req)`` dispatches on ``req.planner.name`` to the installed planner plugin of that name
+(:mod:`graspexp.planning.registry`); ``optimal`` is the paper's strategy (section III,
+:mod:`graspexp.planning.optimal`).
 """
 
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.optimal import plan_optimal
-from graspexp.planning.registry import PLANNERS, UnknownPlanner, get_planner, plan, register_planner
+from graspexp.planning.registry import Planner, UnknownPlanner, get_planner, plan
 from graspexp.planning.request import PlanRequest, PlanResult
 
 __all__ = [
-    "PLANNERS",
     "Grasp",
     "NoFeasibleGrasp",
     "PlanRequest",
     "PlanResult",
+    "Planner",
     "UnknownPlanner",
     "get_planner",
     "plan",
     "plan_optimal",
-    "register_planner",
 ]

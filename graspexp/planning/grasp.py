@@ -12,21 +12,22 @@ class Grasp:
     pose : (4,4) world pose of the gripper frame (paper Fig. 9): +Z approach direction (towards the
         object), +X main axis, +Y = Z x X closing axis; origin = grasp point midway between the pads.
     width_m : planned opening between the pads, m.
-    cost : the planner's score (lower is better for ``optimal``).
+    cost : the planner's score, lower is better (optional: NaN).
     cluster : index k of the chosen cluster (-1 where the planner has none).
     path : index p of the chosen path in that cluster (-1 where the planner has none).
-    n_feasible : number of candidate paths that survived the feasibility checks.
-    planner : registry name of the planner that made it.
+    n_feasible : number of candidate paths that survived the feasibility checks (optional: 1).
+    planner : registry name of the planner that made it (optional: filled in by
+        :func:`graspexp.planning.plan` from ``planner.name``).
     extras : planner-specific scalars for logs (e.g. K, M).
     """
 
     pose: np.ndarray
     width_m: float
-    cost: float
-    cluster: int
-    path: int
-    n_feasible: int
-    planner: str
+    cost: float = float("nan")
+    cluster: int = -1
+    path: int = -1
+    n_feasible: int = 1
+    planner: str = ""
     extras: dict = field(default_factory=dict)
 
     @property

@@ -1,6 +1,6 @@
 """The paper's optimal grasping strategy (section III), as one pure function of a :class:`PlanRequest`.
 
-Every choice the paper leaves open is a ``planner`` config key (graspexp/config/planner.py says which
+Every choice the paper leaves open is a ``planner`` config key (graspexp/config/planner/optimal.py says which
 sentence each rests on); the presets ``optimal`` (this project's reading) and ``optimal_literal`` (the
 paper as printed) differ only in those keys. Steps (the cloud arrives already transformed by the
 object pose: world frame, metres):

@@ -1,64 +1,55 @@
-"""Planners chosen by name: ``planner.name`` in the config is the key of :data:`PLANNERS`.
+"""Planners chosen by name: ``planner.name`` is the entry-point name of an installed planner plugin.
 
-Every planner is a pure function ``PlanRequest -> PlanResult``. Add one with
-``register_planner("name", fn)`` (or ``PLANNERS["name"] = fn``) from the module that defines it.
+Every planner is a pure function ``PlanRequest -> PlanResult``. Planners (the built-in ones too) are
+discovered through the ``graspexp.planners`` entry-point group (:mod:`graspexp.config.plugins`); the
+function of a plugin that gives it as ``"module:function"`` is imported here, on first use.
 """
 
+import dataclasses
+import functools
+import importlib
 from collections.abc import Callable
 
-from graspexp.planning.optimal import LITERAL_NAME as OPTIMAL_LITERAL_NAME
-from graspexp.planning.optimal import NAME as OPTIMAL_NAME
-from graspexp.planning.optimal import plan_optimal
+from graspexp.config.plugins import PluginError, get_plugin
 from graspexp.planning.request import PlanRequest, PlanResult
 
 Planner = Callable[[PlanRequest], PlanResult]
 
-PLANNERS: dict[str, Planner] = {OPTIMAL_NAME: plan_optimal, OPTIMAL_LITERAL_NAME: plan_optimal}
 
-
-class UnknownPlanner(KeyError):
-    """``planner.name`` names no registered planner."""
+class UnknownPlanner(PluginError, KeyError):
+    """``planner.name`` names no installed planner, or one whose plugin cannot be loaded."""
 
     def __str__(self) -> str:  # KeyError would quote the whole message
         return str(self.args[0])
 
 
-def register_planner(name: str, fn: Planner) -> Planner:
-    """Register ``fn`` under ``name`` (a name may be registered once); returns ``fn``."""
-    if name in PLANNERS and PLANNERS[name] is not fn:
-        raise ValueError(f"planner {name!r} is already registered")
-    PLANNERS[name] = fn
+@functools.cache
+def get_planner(name: str) -> Planner:
+    """The plan function of the planner called ``name``; :class:`UnknownPlanner` (one line naming the
+    valid names, or the broken plugin's package) otherwise."""
+    try:
+        found = get_plugin(name)
+    except PluginError as exc:
+        raise UnknownPlanner(str(exc)) from None
+    fn = found.plugin.plan
+    if isinstance(fn, str):
+        module, _, attr = fn.partition(":")
+        try:
+            fn = getattr(importlib.import_module(module), attr)
+        except (ImportError, AttributeError) as exc:
+            raise UnknownPlanner(
+                f"planner {name!r} of {found.package}: its plan function {found.plugin.plan} cannot be "
+                f"imported: {type(exc).__name__}: {exc}"
+            ) from None
     return fn
 
 
-def get_planner(name: str) -> Planner:
-    """The planner registered as ``name``; an unknown name raises :class:`UnknownPlanner` listing the valid ones."""
-    try:
-        return PLANNERS[name]
-    except KeyError:
-        valid = ", ".join(sorted(PLANNERS))
-        raise UnknownPlanner(f"planner.name={name!r} is unknown: expected one of {valid}") from None
-
-
 def plan(req: PlanRequest) -> PlanResult:
-    """Dispatch on ``req.planner.name``."""
-    return get_planner(req.planner.name)(req)
-
-
-# Baselines and the improved planner (graspexp/planning/{antipodal,obb,random_grasp,optimal_plus}.py).
-from graspexp.planning.antipodal import NAME as ANTIPODAL_NAME  # noqa: E402
-from graspexp.planning.antipodal import plan_antipodal  # noqa: E402
-from graspexp.planning.obb import NAME as OBB_NAME  # noqa: E402
-from graspexp.planning.obb import plan_obb  # noqa: E402
-from graspexp.planning.optimal_plus import NAME as OPTIMAL_PLUS_NAME  # noqa: E402
-from graspexp.planning.optimal_plus import plan_optimal_plus  # noqa: E402
-from graspexp.planning.random_grasp import NAME as RANDOM_NAME  # noqa: E402
-from graspexp.planning.random_grasp import plan_random  # noqa: E402
-
-for _name, _fn in (
-    (ANTIPODAL_NAME, plan_antipodal),
-    (OBB_NAME, plan_obb),
-    (RANDOM_NAME, plan_random),
-    (OPTIMAL_PLUS_NAME, plan_optimal_plus),
-):
-    register_planner(_name, _fn)
+    """Dispatch on ``req.planner.name``; a grasp without a planner name gets ``req.planner.name``."""
+    name = req.planner.name
+    res = get_planner(name)(req)
+    if not isinstance(res, PlanResult):
+        raise TypeError(f"planner {name!r} returned a {type(res).__name__}: expected a graspexp PlanResult")
+    if not res.grasp.planner:
+        res = dataclasses.replace(res, grasp=dataclasses.replace(res.grasp, planner=name))
+    return res

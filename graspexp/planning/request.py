@@ -18,6 +18,9 @@ class PlanRequest:
     object_pose : (4,4) perceived world pose of the object frame.
     table_z : height of the support plane z = h, m.
     mode : ``collab`` (Eq. 1) or ``bin`` (Eq. 2-3).
+    gripper : the gripper model (stroke, finger and palm boxes), m.
+    planner : the planner's own config (its plugin's schema, a :class:`PlannerConfig` subclass).
+    cost : the constants of Eq. (1)-(3).
     seed : seed for anything random in the planner.
     """
 

@@ -3,7 +3,7 @@
 import numpy as np
 from omegaconf import OmegaConf
 
-from graspexp.config import JobConfig
+from graspexp.config.registry import job_config_from_yaml
 from graspexp.datasets import load_object
 from graspexp.planning import plan
 from graspexp.quality import fc_min_mu
@@ -35,7 +35,7 @@ def resimulate(log) -> tuple[bool, str]:
     match within :data:`POSE_TOLERANCE`.
     """
     meta = log.metadata
-    cfg = OmegaConf.merge(OmegaConf.structured(JobConfig), OmegaConf.create(meta["config_yaml"]))
+    cfg = job_config_from_yaml(meta["config_yaml"])
     plain = OmegaConf.to_object(cfg)
     name, trial, seed = meta["object"], int(meta["trial"]), int(meta["trial_seed"])
     model = load_object(cfg.dataset, name, cfg.planner.n_points, derive_seed(cfg.seed, "cloud", name))

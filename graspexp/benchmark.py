@@ -1,0 +1,351 @@
+"""``python -m graspexp.benchmark planner=NAME [dataset=...] [key=value ...]``: the standard suite for any
+installed planner, ranked beside the built-in planners and the paper's published numbers.
+
+The standard suite: the paper's four settings (collab / bin x rotation z / xyz) on Table 1 (``ycb``) and
+Table 2 (``linemod``), :data:`graspexp.report.paper.TRIALS_PER_SETTING` trials per object, at zero pose
+noise and at each of :data:`NOISE_LEVELS`. Every planner runs the same drops (a drop depends only on the
+seed, dataset, object and trial index). Keys (``key=value``; values in YAML):
+
+- ``planner`` (required): the planner entered; ``dataset``: one dataset or a list (default ycb, linemod);
+- ``settings``: list of ``mode/rot`` (default the four); ``trials``; ``objects``: a subset;
+  ``noise``: list of ``[trans_mm, rot_deg]`` levels besides zero (``[]``: none);
+- ``compare``: planners ranked beside it (default the built-in ones; they run too where their results
+  are missing, once, and are reused by every later entrant); ``out`` (default ``outputs/benchmark``);
+- ``n_jobs`` (default 2): jobs in parallel with joblib; ``launcher=submitit``: one SLURM array task per
+  job through submitit (``slurm_partition=``, ``timeout_min=``; where no SLURM exists submitit runs them
+  as local processes);
+- any other ``key=value`` is a job override: ``planner.*`` for the entered planner only, the rest
+  (``gripper=``, ``sim.*``, ...) for every planner.
+
+Output, one folder per planner, ``OUT/<planner>/``: ``runs/<dataset>/<mode>_<rot>_t<mm>_r<deg>/`` (the
+runner's job directories: resumable, locked, one MCAP log per trial), ``summary.md`` (ranking and tables),
+``ranking.csv``, ``noise.csv``, ``failures.csv`` and ``reproduce.json`` (command, every job's composed
+config, package versions, planner package and version). Re-running the same command resumes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+import yaml
+from omegaconf import OmegaConf
+
+from graspexp.cli import compose_config, fail
+from graspexp.compare.report import FC_MU, check_same_drops, render_markdown
+from graspexp.compare.report import success_table as noise_success_table
+from graspexp.config import ConfigError, PluginError, validate
+from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
+from graspexp.report.collect import collect
+from graspexp.report.contact_area import finger_contacts_in_area
+from graspexp.report.paper import PAPER_TABLES, SETTINGS, TRIALS_PER_SETTING
+from graspexp.report.render import display_frame, footnotes, markdown
+from graspexp.report.stats import percentiles, wilson_interval
+from graspexp.report.tables import failure_breakdown, success_table
+
+NOISE_LEVELS: tuple[tuple[float, float], ...] = ((10.0, 0.0), (20.0, 0.0), (0.0, 10.0))
+"""Pose-noise levels (translation std mm, rotation std degrees) run besides zero, as in ``nox -s compare``."""
+IN_AREA_NOTE = (
+    "In-area contact %: share of the finger-object contacts at the end of closing whose nearest point of "
+    "the object's cloud is a grasping-area point (graspexp/report/contact_area.py; from each log's "
+    "/contacts and /tf), over the trials whose fingers touch the object then."
+)
+
+
+@dataclass
+class Benchmark:
+    """What one ``python -m graspexp.benchmark`` command runs (see the module doc)."""
+
+    planner: str
+    datasets: list[str] = field(default_factory=lambda: list(PAPER_TABLES))
+    settings: list[str] = field(default_factory=lambda: [f"{m}/{r}" for m, r in SETTINGS])
+    trials: int = TRIALS_PER_SETTING
+    objects: list[str] | None = None
+    noise: list[list[float]] = field(default_factory=lambda: [list(n) for n in NOISE_LEVELS])
+    compare: list[str] | None = None
+    out: str = "outputs/benchmark"
+    n_jobs: int = 2
+    launcher: str = "joblib"
+    slurm_partition: str = ""
+    timeout_min: int = 240
+    overrides: list[str] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class Job:
+    planner: str
+    dataset: str
+    mode: str
+    rot: str
+    trans_mm: float
+    rot_deg: float
+    overrides: tuple[str, ...]
+    run_dir: str
+
+
+def parse_args(argv: list[str]) -> Benchmark:
+    """``key=value`` tokens -> :class:`Benchmark`; unknown keys become job overrides."""
+    keys = {f.name for f in dataclasses.fields(Benchmark)} - {"overrides", "datasets"}
+    values: dict = {"overrides": []}
+    for tok in argv:
+        key, sep, raw = tok.partition("=")
+        if not sep:
+            raise ConfigError(
+                f"{tok!r} is invalid: expected key=value (python -m graspexp.benchmark planner=NAME)"
+            )
+        if key == "dataset":
+            value = yaml.safe_load(raw)
+            values["datasets"] = value if isinstance(value, list) else [str(value)]
+        elif key in keys:
+            values[key] = yaml.safe_load(raw) if key not in ("planner", "out") else raw
+        else:
+            values["overrides"].append(tok)
+    if "planner" not in values:
+        raise ConfigError("planner is missing: python -m graspexp.benchmark planner=NAME [dataset=...]")
+    bench = Benchmark(**values)
+    for s in bench.settings:
+        if s.count("/") != 1:
+            raise ConfigError(f"settings entry {s!r} is invalid: expected mode/rot, e.g. collab/z")
+    if bench.launcher not in ("joblib", "submitit"):
+        raise ConfigError(f"launcher={bench.launcher!r} is invalid: expected one of joblib, submitit")
+    return bench
+
+
+def compared(bench: Benchmark) -> list[str]:
+    """The planners ranked beside the entered one: ``compare`` or every built-in planner."""
+    if bench.compare is not None:
+        return [p for p in bench.compare if p != bench.planner]
+    builtin = [
+        n
+        for n, p in load_planners().items()
+        if isinstance(p, LoadedPlanner) and p.package.startswith("graspexp ")
+    ]
+    return [n for n in builtin if n != bench.planner]
+
+
+def jobs(bench: Benchmark) -> list[Job]:
+    """Every (planner, dataset, setting, noise level) job of the suite, entered planner first."""
+    shared = [o for o in bench.overrides if not o.lstrip("+~").startswith("planner.")]
+    own = [o for o in bench.overrides if o.lstrip("+~").startswith("planner.")]
+    levels = [(0.0, 0.0)] + [(float(t), float(r)) for t, r in bench.noise if (t, r) != (0, 0)]
+    objects = [f"objects=[{','.join(bench.objects)}]"] if bench.objects else []
+    out = []
+    for planner in [bench.planner, *compared(bench)]:
+        for dataset in bench.datasets:
+            for setting in bench.settings:
+                mode, rot = setting.split("/")
+                for t, r in levels:
+                    overrides = (
+                        f"planner={planner}",
+                        f"dataset={dataset}",
+                        f"mode={mode}",
+                        f"rot={rot}",
+                        f"perception.noise.trans_mm={t}",
+                        f"perception.noise.rot_deg={r}",
+                        f"trials={bench.trials}",
+                        "progress=false",
+                        *objects,
+                        *shared,
+                        *(own if planner == bench.planner else []),
+                    )
+                    run_dir = Path(bench.out) / planner / "runs" / dataset / f"{mode}_{rot}_t{t:g}_r{r:g}"
+                    out.append(Job(planner, dataset, mode, rot, t, r, overrides, str(run_dir)))
+    return out
+
+
+def run_one(job: Job) -> str:
+    """Run (or resume) one job; '' on success, else the one-line reason."""
+    from graspexp.runner import run_in_dir
+
+    try:
+        run_in_dir(compose_config(list(job.overrides)), Path(job.run_dir))
+    except Exception as exc:  # one job's failure is reported; the others run
+        return f"{job.run_dir}: {type(exc).__name__}: {exc}"
+    return ""
+
+
+def run_all(bench: Benchmark, todo: list[Job]) -> list[str]:
+    """Run the jobs (joblib processes, or submitit / SLURM); the error line of each failed job."""
+    if bench.launcher == "submitit":
+        import submitit
+
+        executor = submitit.AutoExecutor(folder=Path(bench.out) / "submitit")
+        params = {"timeout_min": bench.timeout_min, "cpus_per_task": 1}
+        if bench.slurm_partition:
+            params["slurm_partition"] = bench.slurm_partition
+        executor.update_parameters(**params)
+        return [e for e in (j.result() for j in executor.map_array(run_one, todo)) if e]
+    from joblib import Parallel, delayed
+
+    return [e for e in Parallel(n_jobs=bench.n_jobs)(delayed(run_one)(j) for j in todo) if e]
+
+
+def results(all_jobs: list[Job]) -> pd.DataFrame:
+    """One row per readable trial log of every job: report.collect columns plus trans_mm, rot_deg and the
+    finger-object contacts at the end of closing (``contacts``) and how many lie in the grasping area
+    (``contacts_in_area``)."""
+    frames = []
+    for job in all_jobs:
+        if Path(job.run_dir).is_dir():
+            df = collect(job.run_dir).results
+            if not df.empty:
+                counts = [finger_contacts_in_area(p) for p in df["path"]]
+                df = df.assign(
+                    trans_mm=job.trans_mm,
+                    rot_deg=job.rot_deg,
+                    contacts_in_area=[c[0] for c in counts],
+                    contacts=[c[1] for c in counts],
+                )
+                frames.append(df)
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+
+
+def _success(g: pd.DataFrame) -> str:
+    k, n = int(g["success"].sum()), len(g)
+    lo, hi = wilson_interval(k, n)
+    return f"{100 * k / n:.0f} [{100 * lo:.0f}, {100 * hi:.0f}] ({n})" if n else "n/a"
+
+
+def ranking(df: pd.DataFrame, dataset: str, settings: list[str]) -> pd.DataFrame:
+    """Zero-noise trials of one dataset: one row per planner, best success first, then the paper's
+    printed Average of its own method (where the paper reports this dataset)."""
+    rows = []
+    zero = df[(df["dataset"] == dataset) & (df["trans_mm"] == 0) & (df["rot_deg"] == 0)]
+    for planner, g in zero.groupby("planner", sort=True):
+        row = {"planner": planner, "success % [95% CI] (n)": _success(g), "_rate": g["success"].mean()}
+        for s in settings:
+            mode, rot = s.split("/")
+            row[s] = _success(g[(g["mode"] == mode) & (g["rot"] == rot)])
+        planned = g[g["reason"] != "no_feasible_grasp"]
+        touched = int(g["contacts"].sum())
+        row["in-area contact %"] = f"{100 * g['contacts_in_area'].sum() / touched:.0f}" if touched else "n/a"
+        row[f"force-closure % (mu<={FC_MU:g})"] = (
+            f"{100 * (planned['fc_min_mu'] <= FC_MU + 1e-9).mean():.0f}" if len(planned) else "n/a"
+        )
+        mu = planned["fc_min_mu"].median() if len(planned) else math.nan
+        row["median min mu"] = f"{mu:.2f}"
+        p50, p95 = percentiles(g["plan_ms"])
+        row["plan ms p50 / p95"] = f"{p50:.0f} / {p95:.0f}"
+        reasons = g.loc[~g["success"], "reason"].fillna("(none)").value_counts()
+        row["failures"] = ", ".join(f"{r} {c}" for r, c in reasons.head(3).items()) or "none"
+        rows.append(row)
+    table = pd.DataFrame(rows)
+    if not table.empty:
+        table = table.sort_values(["_rate", "planner"], ascending=[False, True]).drop(columns="_rate")
+    paper = PAPER_TABLES.get(dataset)
+    if paper is not None:
+        printed = dict(zip([f"{m}/{r}" for m, r in SETTINGS], paper.ours_average, strict=True))
+        shown = [printed[s] for s in settings if s in printed]
+        row = {"planner": "paper (printed Average, its own method)"}
+        row["success % [95% CI] (n)"] = f"{sum(shown) / len(shown):.0f}" if shown else "n/a"
+        row.update({s: f"{printed[s]:.0f}" if s in printed else "n/a" for s in settings})
+        table = pd.concat([table, pd.DataFrame([row])], ignore_index=True).fillna("")
+    return table
+
+
+def reproduce_record(bench: Benchmark, all_jobs: list[Job], configs: list[dict], argv: list[str]) -> dict:
+    """Everything needed to re-run the suite: command, benchmark keys, each job's composed config
+    (``configs``, in job order), package versions, and each planner's package, entry point and version."""
+    from graspexp.runner import package_versions
+
+    planners = {}
+    for name in dict.fromkeys(j.planner for j in all_jobs):
+        p = get_plugin(name)
+        planners[name] = {"package": p.package, "entry_point": p.entry_point, "version": p.version}
+    return {
+        "command": "python -m graspexp.benchmark " + " ".join(argv),
+        "benchmark": dataclasses.asdict(bench),
+        "packages": package_versions(),
+        "planners": planners,
+        "jobs": [
+            {
+                **{k: v for k, v in dataclasses.asdict(j).items() if k != "overrides"},
+                "overrides": list(j.overrides),
+                "config": c,
+            }
+            for j, c in zip(all_jobs, configs, strict=True)
+        ],
+    }
+
+
+def write_summary(
+    bench: Benchmark, all_jobs: list[Job], configs: list[dict], errors: list[str], argv: list[str]
+) -> str:
+    """Write the result folder ``OUT/<planner>/`` (module doc); returns the Markdown summary."""
+    out = Path(bench.out) / bench.planner
+    out.mkdir(parents=True, exist_ok=True)
+    df = results(all_jobs)
+    lines = [f"# Benchmark: planner `{bench.planner}`", ""]
+    if df.empty:
+        lines.append("No readable trial logs.")
+    else:
+        df = df[df["planner"].isin([bench.planner, *compared(bench)])]
+        rankings = []
+        for dataset in bench.datasets:
+            table = ranking(df, dataset, bench.settings)
+            rankings.append(table.assign(dataset=dataset))
+            lines += [f"## Ranking on `{dataset}` (zero pose noise)", "", markdown(table, index=False), ""]
+        lines += [
+            "Success: successes / trials with the Wilson 95 % score interval; plan time: wall time of the "
+            f"plan call (ms); force-closure: share of planned grasps force-closure at mu <= {FC_MU:g}, and "
+            "the median smallest such mu (NaN: none); failures: the three most frequent reasons.",
+            IN_AREA_NOTE,
+            "",
+        ]
+        pd.concat(rankings).to_csv(out / "ranking.csv", index=False)
+        zero = df[(df["trans_mm"] == 0) & (df["rot_deg"] == 0)]
+        for dataset in bench.datasets:
+            if dataset in PAPER_TABLES and (zero["dataset"] == dataset).any():
+                st = success_table(zero, dataset, bench.planner)
+                lines += [f"## `{bench.planner}` beside the paper's Table {st.paper.number}", ""]
+                lines += [markdown(display_frame(st)), "", *(f"- {n}" for n in footnotes(st)), ""]
+        noise = noise_success_table(df)
+        noise.to_csv(out / "noise.csv", index=False)
+        lines += ["## Every setting and pose-noise level", ""]
+        lines += render_markdown(noise, check_same_drops(df), []).splitlines()[2:]
+        failures = failure_breakdown(zero)
+        failures.to_csv(out / "failures.csv", index=False)
+        lines += ["", "## Failure reasons (zero pose noise)", "", markdown(failures, index=False), ""]
+    if errors:
+        lines += ["## Jobs that did not finish", "", *(f"- {e}" for e in errors), ""]
+    text = "\n".join(lines) + "\n"
+    (out / "summary.md").write_text(text)
+    (out / "reproduce.json").write_text(
+        json.dumps(reproduce_record(bench, all_jobs, configs, argv), indent=1)
+    )
+    return text
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if any(a in ("-h", "--help") for a in argv):
+        print(__doc__)
+        return 0
+    try:
+        bench = parse_args(argv)
+        get_plugin(bench.planner)
+        all_jobs = jobs(bench)
+        configs = []
+        for job in all_jobs:  # every job's config is checked before the first trial runs
+            cfg = compose_config(list(job.overrides))
+            validate(cfg)
+            configs.append(OmegaConf.to_container(cfg, resolve=True))
+    except (ConfigError, PluginError) as exc:
+        fail(str(exc))
+    except Exception as exc:  # Hydra composition errors: one line, no traceback
+        fail(str(exc).splitlines()[0])
+    errors = run_all(bench, all_jobs)
+    print(write_summary(bench, all_jobs, configs, errors, argv), end="")
+    print(f"graspexp.benchmark: results in {Path(bench.out) / bench.planner}", file=sys.stderr)
+    for e in errors:
+        print(f"graspexp.benchmark: job failed: {e}", file=sys.stderr)
+    return 1 if errors else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

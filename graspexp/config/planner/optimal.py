@@ -1,0 +1,96 @@
+"""Schema of the paper's planner (``optimal``, ``optimal_literal``; graspexp/planning/optimal.py).
+
+Every place where the paper is silent is a key here; its docstring quotes the sentence it rests on.
+"""
+
+from dataclasses import dataclass
+from typing import Any
+
+from graspexp.config.constraints import BOOL, Interval, Options
+from graspexp.config.planner.base import BASE_CONSTRAINTS, PlannerConfig
+from graspexp.config.plugins import PlannerPlugin
+
+
+@dataclass
+class PaperPathsConfig(PlannerConfig):
+    """Grasping area -> K-means -> Fibonacci paths -> cost (section III): shared by ``optimal_plus``."""
+
+    k: Any = "auto"
+    """Number of K-means clusters: ``auto`` (rule of ``auto_k_stroke_fraction``) or a positive int. IV-D:
+    "The cluster K depends on the gripper size and the size of the grasping area" (no formula given)."""
+    k_max: int = 8
+    """Upper bound on K when ``k: auto``."""
+    m: int = 256
+    """Grasping paths (Fibonacci sphere points) per cluster; IV-D: "we set the parameter M as 256"."""
+    table_clearance_m: float = 0.0
+    """A path is dropped when its sphere point lies below the support plane plus this, m; 0 = III-D's
+    "paths that will pass through the desktop" taken at the path's start point."""
+    seed: int = 0
+    """Seed of the K-means initialisation (combined with the trial seed)."""
+    main_axis: str = "object"
+    """Cloud whose first principal component is the main axis of Eq. (1)'s alpha and of the K rule's
+    length: ``object`` (the whole cloud; III-D: "the main axis by reducing the dimensionality of the
+    object's point cloud"; the cost term is "the intersection angle between path p and the main axis of
+    the object") or ``area`` (the grasping area, Fig. 7). The area's axis is ill-conditioned for bands
+    around cylinders (two near-equal eigenvalues), hence the default."""
+    pose_axis: str = "object"
+    """Cloud whose main axis becomes the grasp frame's +X (Fig. 9): ``area`` as printed ("the main axis
+    of the grasping area which is produced by PCA", III-D) or ``object``. Default ``object``: on a band
+    around a cylinder the area's axis can lie across the object and put the closing axis along it."""
+    auto_k_stroke_fraction: float = 1.0
+    """``k: auto``: K = clamp(ceil(L / (fraction * gripper.max_width_m)), 1, k_max), L = the area's extent
+    along the main axis, m/m. III-B: clusters are "more precise areas to fit the size of the gripper",
+    "a bigger gripper has fewer clusters": 1.0 makes each cluster about one stroke long."""
+    cluster_radius: str = "max"
+    """Definition of r_k (III-D: "the radius of the k-th cluster"), used by Eq. (1) and the opening:
+    ``max`` = the largest distance of the cluster's points from c_k (the radius of the ball about c_k
+    that holds the cluster: fingers opened to 2 r_k clear every point of it, and Eq. (1) then penalises
+    points at the fingers' distance from the path, "to prevent the gripper from colliding") or ``rms``
+    = the root-mean-square distance (ignores outlying points), m."""
+    width_margin: float = 0.2
+    """Opening = 2 r_k (1 + margin), clipped to the gripper stroke (dimensionless). The paper opens to
+    "the diameter of the grasping area found by the method" (0 = as printed); 0.2 leaves clearance for
+    the pads' thickness and the perception error."""
+
+
+PAPER_PATHS_CONSTRAINTS = {
+    **BASE_CONSTRAINTS,
+    "k": [Options(("auto",)), Interval(1, 64, integer=True)],
+    "k_max": [Interval(1, 64, integer=True)],
+    "m": [Interval(1, 100_000, integer=True)],
+    "table_clearance_m": [Interval(-1, 1, unit="m")],
+    "seed": [Interval(0, None, integer=True)],
+    "main_axis": [Options(("object", "area"))],
+    "pose_axis": [Options(("object", "area"))],
+    "auto_k_stroke_fraction": [Interval(0, 10, "right")],
+    "cluster_radius": [Options(("max", "rms"))],
+    "width_margin": [Interval(0, 10)],
+}
+
+
+@dataclass
+class OptimalConfig(PaperPathsConfig):
+    """The paper's planner; presets ``conf/planner/optimal.yaml`` and ``optimal_literal.yaml``."""
+
+    grasp_point: str = "section_middle"
+    """Origin of the grasp frame: ``centre`` = c_k, as printed (the paths of Fig. 6 end at the cluster
+    centre), or ``section_middle`` = c_k moved along the closing axis Y to the middle of the object's
+    section between the pads: the pads of a parallel gripper close symmetrically about the TCP, so
+    closing about an off-centre c_k lands one pad first and pushes the object."""
+    section_fit: bool = True
+    """Keep a path only if the object's section between the pads fits its opening (cheapest such path
+    wins; if none fits, the cheapest whose section fits the stroke, opened to the section). Not in the
+    paper (its cost is what steers paths away from the object); False = the printed argmin of the cost."""
+
+
+CONSTRAINTS = {
+    **PAPER_PATHS_CONSTRAINTS,
+    "grasp_point": [Options(("centre", "section_middle"))],
+    "section_fit": BOOL,
+}
+"""Allowed values of every ``planner`` key of :class:`OptimalConfig` (see :mod:`graspexp.config.constraints`)."""
+
+PLUGIN = PlannerPlugin(
+    plan="graspexp.planning.optimal:plan_optimal", config=OptimalConfig, constraints=CONSTRAINTS
+)
+"""Entry point of ``optimal`` and of ``optimal_literal`` (the same function, another preset)."""

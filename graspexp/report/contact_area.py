@@ -1,0 +1,69 @@
+"""Where the fingers touch: the share of finger contacts that lie inside the object's grasping area.
+
+Read from a trial log: at the end of closing (the last ``/contacts`` message before the phase that
+follows ``close``), each finger-object contact (the force-weighted mean point of the pair, world frame)
+is moved into the object frame by the object's ``/tf`` pose at that time; it is *in the area* when the
+nearest point of the object's cloud (the one the planner saw: same size and seed as the run) is a
+grasping-area point. Trials whose fingers do not touch the object then have no contacts to count.
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+import numpy as np
+from omegaconf import OmegaConf
+from scipy.spatial import cKDTree
+
+from graspexp.config import DatasetConfig
+from graspexp.datasets import load_object
+from graspexp.geometry import make_pose, quat_wxyz_to_matrix, transform_points
+from graspexp.record import read_trial
+from graspexp.seeding import derive_seed
+
+FINGERS = ("finger_left", "finger_right")
+OBJECT = "object"
+
+
+@functools.lru_cache(maxsize=64)
+def _area_index(dataset_yaml: str, name: str, n_points: int, seed: int) -> tuple[cKDTree, np.ndarray]:
+    dataset = OmegaConf.merge(OmegaConf.structured(DatasetConfig), OmegaConf.create(dataset_yaml))
+    model = load_object(dataset, name, n_points, derive_seed(seed, "cloud", name))
+    return cKDTree(model.points), model.area_mask
+
+
+def _at(times: np.ndarray, t_s: float) -> int:
+    return max(int(np.searchsorted(times, t_s + 1e-9, side="right")) - 1, 0)
+
+
+def finger_contacts_in_area(path: Path | str) -> tuple[int, int]:
+    """(finger-object contacts in the grasping area, all finger-object contacts) at the end of closing;
+    (0, 0) for a trial that never closed or whose fingers do not touch the object then."""
+    log = read_trial(path)
+    names = [n for _, n, _ in log.phases]
+    if "close" not in names or OBJECT not in log.transforms:
+        return 0, 0
+    i = names.index("close")
+    end = log.phases[i + 1][0] if i + 1 < len(log.phases) else np.inf
+    before = [c for t, c in log.contacts if t <= end + 1e-9]
+    if not before:
+        return 0, 0
+    t_end = max(t for t, _ in log.contacts if t <= end + 1e-9)
+    pairs = [
+        c
+        for c in before[-1]
+        if {c["body0"], c["body1"]} & set(FINGERS) and OBJECT in (c["body0"], c["body1"])
+    ]
+    if not pairs:
+        return 0, 0
+    times, pos, quat = log.transforms[OBJECT]
+    j = _at(times, t_end)
+    world_from_object = make_pose(quat_wxyz_to_matrix(quat[j]), pos[j])
+    local = transform_points(np.linalg.inv(world_from_object), np.array([c["position"] for c in pairs]))
+    cfg = OmegaConf.create(log.metadata["config_yaml"])
+    tree, area = _area_index(
+        OmegaConf.to_yaml(cfg.dataset), log.result["object"], int(cfg.planner.n_points), int(cfg.seed)
+    )
+    _, nearest = tree.query(local)
+    return int(area[nearest].sum()), len(pairs)
