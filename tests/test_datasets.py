@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import numpy as np
@@ -26,15 +25,6 @@ from graspexp.datasets.catalog import DATASETS, YCB_MASS_KG
 from graspexp.datasets.loader import _load_mesh_cached
 
 REPO = Path(__file__).resolve().parents[1]
-
-
-@pytest.fixture(scope="session")
-def data_root() -> Path:
-    """The shared test meshes: $GRASPEXP_DATA, else ../shared/datasets beside the checkout."""
-    root = Path(os.environ.get("GRASPEXP_DATA") or REPO.parent / "shared" / "datasets")
-    if not (root / "ycb").is_dir() or not (root / "linemod").is_dir():
-        pytest.skip(f"test meshes not found at {root}")
-    return root
 
 
 @pytest.fixture(scope="session")
