@@ -95,6 +95,7 @@ def test_plan_cli_prints_one_json_object_and_dumps(tmp_path, capsys, monkeypatch
     assert not list(tmp_path.glob("outputs"))  # compose API: no Hydra run folder
 
 
+@pytest.mark.slow
 def test_plan_cli_unknown_object_is_one_line_and_non_zero():
     proc = subprocess.run(
         [sys.executable, "-m", "graspexp.plan", "dataset=primitives", "object=teapot"],

@@ -406,6 +406,7 @@ def _offsets(size: int) -> list[int]:
     return sorted(set(range(0, 200)) | set(range(200, size - 600, 7)) | set(range(max(size - 600, 0), size)))
 
 
+@pytest.mark.slow
 def test_truncations_of_a_small_log_are_corrupt(tmp_path):
     data = _small_log()
     bad = tmp_path / "cut.mcap"
@@ -416,6 +417,7 @@ def test_truncations_of_a_small_log_are_corrupt(tmp_path):
                 fn(bad)
 
 
+@pytest.mark.slow
 def test_byte_flips_are_corrupt(tmp_path):
     data = _small_log()
     bad = tmp_path / "flip.mcap"

@@ -188,6 +188,7 @@ def test_failure_breakdown_and_runtime(sweep_dir: Path) -> None:
     assert (rt.loc["ycb", "p50_ratio"], rt.loc["linemod", "p50_ratio"]) == pytest.approx((0.5, 2.0))
 
 
+@pytest.mark.slow
 def test_report_cli_writes_markdown_csv_latex_png(sweep_dir: Path, tmp_path: Path, capsys) -> None:
     out = tmp_path / "rep"
     assert report_main([str(sweep_dir), "--out", str(out)]) == 0
@@ -217,6 +218,7 @@ def test_report_cli_on_a_dir_without_logs_is_an_error(tmp_path: Path, capsys) ->
     assert "no trial logs" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_corrupt_and_unfinished_logs_are_named_not_dropped(sweep_dir: Path, tmp_path: Path, capsys) -> None:
     import shutil
 

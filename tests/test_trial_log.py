@@ -18,7 +18,7 @@ from graspexp.seeding import derive_seed
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
 
-pytestmark = pytest.mark.sim
+pytestmark = [pytest.mark.sim, pytest.mark.slow]
 REPO = Path(__file__).resolve().parent.parent
 WALL_CLOCK_KEYS = {"timings_s"}
 """Result fields that hold wall-clock time: the only payload bytes allowed to differ between two runs."""
