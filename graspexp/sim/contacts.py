@@ -70,7 +70,10 @@ class SupportTouch:
 def contact_records(contacts: list, dt: float) -> list[dict]:
     """One record per touching body pair for the log (world frame, N, m): the pair's total contact force
     on ``body0``, the force-weighted mean position and normal of its points, and the smallest separation.
-    Pairs whose points all carry (near) zero impulse are proximity reports and are left out."""
+    Pairs whose points all carry (near) zero impulse are proximity reports and are left out. Records are
+    sorted by (body0, body1): PhysX reports the same pairs in an order that can change between processes
+    (it did between a run that built its collision shapes and one that read them from the cache), and a
+    log must not."""
     out = []
     for c in contacts:
         w_sum = px = py = pz = nx = ny = nz = fx = fy = fz = 0.0
@@ -101,4 +104,5 @@ def contact_records(contacts: list, dt: float) -> list[dict]:
                 "separation_m": float(sep),
             }
         )
+    out.sort(key=lambda r: (r["body0"], r["body1"]))
     return out
