@@ -38,7 +38,14 @@ from graspexp.outcome import FailureReason, TrialResult
 from graspexp.planning import plan
 from graspexp.prepare import prepare_shapes
 from graspexp.quality import fc_min_mu
-from graspexp.record import CorruptLogError, read_result, read_trial, trial_recorder
+from graspexp.record import (
+    CorruptLogError,
+    iter_trial_logs,
+    read_result,
+    read_trial,
+    trial_log_path,
+    trial_recorder,
+)
 from graspexp.record.scene import ObjectScene, object_scene
 from graspexp.seeding import derive_seed
 from graspexp.sim.collision_shapes import collision_shape
@@ -80,10 +87,6 @@ def package_versions() -> dict[str, str]:
 class RunError(RuntimeError):
     """A job that cannot run as asked: a missing or unreadable input, an unwritable output folder, a
     directory held by another run or holding logs of another config. The message is one line."""
-
-
-def trial_log_path(run_dir: Path, object_name: str, trial: int) -> Path:
-    return run_dir / "trials" / object_name / f"{trial:03d}.mcap"
 
 
 def job_metadata(cfg: DictConfig) -> dict[str, str]:
@@ -220,7 +223,7 @@ def config_differences(recorded_yaml: str, cfg: DictConfig) -> dict[str, tuple[o
 def check_resumable(cfg: DictConfig, run_dir: Path) -> None:
     """Raise RunError if a finished log in ``run_dir`` was made with a different config (see
     :data:`RESULT_NEUTRAL_KEYS`); partial and unreadable logs are left to be redone."""
-    for path in sorted((run_dir / "trials").glob("*/*.mcap")):
+    for path in iter_trial_logs(run_dir):
         try:
             recorded = read_trial(path).metadata.get("config_yaml", "")
         except CorruptLogError:
