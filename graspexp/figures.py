@@ -31,6 +31,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from graspexp.config.gripper import GripperGeometry  # noqa: E402
 from graspexp.plan import CliError, PlannedObject, compose, load, plan_upright, split_args  # noqa: E402
 
 PATH_STRIDE = 8
@@ -186,12 +187,13 @@ def _draw_pose(planned: PlannedObject, path: Path) -> Path:
         ax.plot(*np.stack([o, o + length * R[:, col]]).T, color=colour, lw=2.5)
     start = o - float(det["sphere_radius"]) * R[:, 2]
     ax.plot(*np.stack([start, o]).T, color="black", lw=1, ls=":")
-    half_w, half_l = g.width_m / 2, gr.finger_length_m / 2
+    geometry = GripperGeometry.of(gr)
+    half_w, root, tip = g.width_m / 2, geometry.root_z_m, geometry.tip_z_m
     y, z = R[:, 1], R[:, 2]
-    for side in (-1.0, 1.0):  # fingers: pads centred on the grasp point, +-width/2 along the closing axis
-        finger = np.stack([o + side * half_w * y - half_l * z, o + side * half_w * y + half_l * z])
+    for side in (-1.0, 1.0):  # fingers: pads +-width/2 along the closing axis, palm face to fingertips
+        finger = np.stack([o + side * half_w * y + root * z, o + side * half_w * y + tip * z])
         ax.plot(*finger.T, color="black", lw=3)
-    palm = np.stack([o - half_w * y - half_l * z, o + half_w * y - half_l * z])
+    palm = np.stack([o - half_w * y + root * z, o + half_w * y + root * z])
     ax.plot(*palm.T, color="black", lw=3)
     _equal_aspect(ax, np.vstack([det["cloud"], start]))
     return _save(fig, path)

@@ -53,12 +53,6 @@ def matrix_to_quat_wxyz(R: np.ndarray) -> np.ndarray:
     return q if q[0] >= 0 else -q
 
 
-def wxyz_to_xyzw(q) -> tuple[float, float, float, float]:
-    """SAPIEN order (w, x, y, z) -> Foxglove order (x, y, z, w), as plain floats."""
-    w, x, y, z = (float(v) for v in q)
-    return x, y, z, w
-
-
 def axis_angle_matrix(axis: np.ndarray, angle_rad: float) -> np.ndarray:
     """Rotation of ``angle_rad`` about ``axis`` (Rodrigues)."""
     a = np.asarray(axis, dtype=float)

@@ -20,7 +20,7 @@ from omegaconf import DictConfig, OmegaConf
 from tqdm import tqdm
 
 from graspexp.config import SimConfig
-from graspexp.datasets import DatasetError, available_objects
+from graspexp.datasets import DatasetError, available_objects, select_objects
 from graspexp.datasets.catalog import dataset_spec
 from graspexp.datasets.loader import object_mesh
 from graspexp.sim.collision_shapes import collision_shape, is_cached
@@ -96,13 +96,12 @@ def staged_objects(dataset_cfg: DictConfig) -> list[str]:
 
 def main(argv: list[str] | None = None) -> None:
     from graspexp.cli import compose_config
-    from graspexp.runner import select_objects
 
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     args = list(sys.argv[1:] if argv is None else argv)
     every = "--all" in args
     cfg = compose_config([a for a in args if a != "--all"])
-    names = staged_objects(cfg.dataset) if every else select_objects(cfg)
+    names = staged_objects(cfg.dataset) if every else select_objects(cfg.dataset, cfg.objects)
     sim = OmegaConf.to_object(cfg.sim)
     t0 = time.perf_counter()
     prepare_shapes(cfg.dataset, sim, names)

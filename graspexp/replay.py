@@ -25,7 +25,7 @@ HEADER_KEYS = ("object", "mode", "rot", "seed", "planner", "trial", "dataset")
 """Header fields, taken from the metadata record, else from the result."""
 
 
-def finger_forces(log: TrialLog) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+def logged_finger_forces(log: TrialLog) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Per contacts message: times (T,) s and, per finger, the summed force magnitude (T,) N on the object."""
     times = np.array([t for t, _ in log.contacts], dtype=float)
     forces = {f: np.zeros(len(times)) for f in FINGER_BODIES}
@@ -63,7 +63,7 @@ def format_timeline(log: TrialLog) -> str:
     lines.append("  " + "  ".join(header))
     lines.append(f"  {log.message_count} messages on {', '.join(sorted(log.topics))}")
 
-    times, forces = finger_forces(log)
+    times, forces = logged_finger_forces(log)
     phases = log.phases
     lines.append("phases (sim time, s):")
     if not phases:

@@ -32,14 +32,23 @@ from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
 from graspexp.config import validate
-from graspexp.datasets import DatasetError, available_objects, dataset_objects, load_object
+from graspexp.datasets import load_object, select_objects
 from graspexp.datasets.model import ObjectModel
+from graspexp.outcome import FailureReason, TrialResult
+from graspexp.planning import plan
 from graspexp.prepare import prepare_shapes
-from graspexp.record import CorruptLogError, read_result, read_trial, trial_recorder
+from graspexp.quality import fc_min_mu
+from graspexp.record import (
+    CorruptLogError,
+    iter_trial_logs,
+    read_result,
+    read_trial,
+    trial_log_path,
+    trial_recorder,
+)
 from graspexp.record.scene import ObjectScene, object_scene
 from graspexp.seeding import derive_seed
 from graspexp.sim.collision_shapes import collision_shape
-from graspexp.sim.outcome import FailureReason, TrialResult
 from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
 
 log = logging.getLogger(__name__)
@@ -78,34 +87,6 @@ def package_versions() -> dict[str, str]:
 class RunError(RuntimeError):
     """A job that cannot run as asked: a missing or unreadable input, an unwritable output folder, a
     directory held by another run or holding logs of another config. The message is one line."""
-
-
-def select_objects(cfg: DictConfig) -> list[str]:
-    """The objects to run: ``objects=[...]`` if given (each must exist), else the dataset's list less
-    the objects whose files are missing (named in a warning with the download command)."""
-    names = dataset_objects(cfg.dataset)
-    if cfg.objects:
-        unknown = [o for o in cfg.objects if o not in names]
-        if unknown:
-            raise DatasetError(f"unknown object(s) {unknown} in dataset {cfg.dataset.name!r}; valid: {names}")
-        return list(cfg.objects)
-    present = available_objects(cfg.dataset)
-    if not present:
-        load_object(cfg.dataset, names[0], 16, 0)  # raises the DatasetError that names the missing path
-    missing = [o for o in names if o not in present]
-    if missing:
-        log.warning(
-            "dataset %s: no mesh for %s under the data root; skipping them (get them with "
-            "`python -m graspexp.download dataset=%s`)",
-            cfg.dataset.name,
-            missing,
-            cfg.dataset.name,
-        )
-    return [o for o in names if o in present]
-
-
-def trial_log_path(run_dir: Path, object_name: str, trial: int) -> Path:
-    return run_dir / "trials" / object_name / f"{trial:03d}.mcap"
 
 
 def job_metadata(cfg: DictConfig) -> dict[str, str]:
@@ -175,7 +156,11 @@ def run_object_trials(
                 recorder = trial_recorder(path if cfg.record else None, meta, plain)
                 with recorder as rec:
                     try:
-                        result = run_trial(TrialContext(plain, model, hulls, i, seed, rec, scene))
+                        result = run_trial(
+                            TrialContext(
+                                plain, model, hulls, i, seed, rec, scene, plan=plan, quality=fc_min_mu
+                            )
+                        )
                     except OSError:
                         raise
                     except Exception as exc:  # one trial's error is recorded; the sweep goes on
@@ -238,7 +223,7 @@ def config_differences(recorded_yaml: str, cfg: DictConfig) -> dict[str, tuple[o
 def check_resumable(cfg: DictConfig, run_dir: Path) -> None:
     """Raise RunError if a finished log in ``run_dir`` was made with a different config (see
     :data:`RESULT_NEUTRAL_KEYS`); partial and unreadable logs are left to be redone."""
-    for path in sorted((run_dir / "trials").glob("*/*.mcap")):
+    for path in iter_trial_logs(run_dir):
         try:
             recorded = read_trial(path).metadata.get("config_yaml", "")
         except CorruptLogError:
@@ -311,7 +296,7 @@ def run_in_dir(cfg: DictConfig, run_dir: Path) -> float:
 
 
 def _run(cfg: DictConfig, run_dir: Path) -> float:
-    objects = select_objects(cfg)
+    objects = select_objects(cfg.dataset, cfg.objects)
     check_resumable(cfg, run_dir)
     prepare_shapes(cfg.dataset, cfg.sim, objects, cfg.progress)
     models = load_models(cfg, objects)

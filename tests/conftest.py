@@ -30,9 +30,10 @@ def _coacd_cache(tmp_path_factory: pytest.TempPathFactory) -> None:
 
 @pytest.fixture(scope="session")
 def data_root() -> Path:
+    """The shared real meshes (``ycb/`` and ``linemod/``); tests that need them skip when they are absent."""
     root = shared_data_root()
-    if not root.is_dir():
-        pytest.skip(f"real meshes not found at {root}")
+    if not (root / "ycb").is_dir() or not (root / "linemod").is_dir():
+        pytest.skip(f"real meshes (ycb/, linemod/) not found at {root}: set GRASPEXP_DATA")
     return root
 
 

@@ -8,8 +8,9 @@ from omegaconf import OmegaConf
 from test_planner_common import RG2  # explicit RG2 dimensions, independent of conf/gripper
 
 from graspexp.cli import compose_config
+from graspexp.config.gripper import GripperGeometry
 from graspexp.planning import Grasp, NoFeasibleGrasp, PlanRequest, get_planner, plan
-from graspexp.planning.collision import cloud_hits, frame_from_axes, gripper_boxes, lowest_z
+from graspexp.planning.collision import cloud_hits, frame_from_axes, lowest_z
 
 MINE = ("antipodal", "obb", "random", "optimal_plus")
 TABLE_Z = 0.1
@@ -210,7 +211,7 @@ def test_lowest_z_of_a_top_down_grasp_is_the_fingertip() -> None:
     gr = _cfg("obb").gripper
     pose = frame_from_axes([0, 0, -1], [0, 1, 0], [0, 0, 0.2])
     assert lowest_z(pose[None], gr, 0.05, 0.1)[0] == pytest.approx(0.2 - gr.tcp_from_tip_m)
-    boxes = gripper_boxes(gr, 0.05)
+    boxes = GripperGeometry.of(gr).boxes(0.05)
     assert boxes[0, 0, 1] == pytest.approx(0.025) and boxes[1, 1, 1] == pytest.approx(-0.025)
 
 

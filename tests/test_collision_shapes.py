@@ -109,6 +109,7 @@ def test_unknown_method_names_the_key_and_the_choices():
         shape_params(SimConfig(collision_method="sdf"))
 
 
+@pytest.mark.slow
 def test_prepare_builds_every_missing_shape_in_parallel(tmp_path):
     cfg = compose_cfg("dataset=primitives", f"sim.cache_dir={tmp_path}", "sim.prepare_workers=2")
     names = ["mug", "banana", "can"]

@@ -5,11 +5,11 @@ import math
 import pandas as pd
 import pytest
 
-from graspexp.compare import check_same_drops, collect_trials, write_report
+from graspexp.compare import check_same_drops, collect_trials, write_comparison
 from graspexp.compare.__main__ import main
+from graspexp.outcome import TrialResult
 from graspexp.record import TrialRecorder
 from graspexp.report.stats import wilson_interval
-from graspexp.sim.outcome import TrialResult
 
 
 def _log(run_dir, planner, obj, trial, seed, success, trans_mm=0.0, rot_deg=0.0, mode="bin") -> None:
@@ -43,7 +43,7 @@ def _sweep(root, successes: dict, noise=((0.0, 0.0),), seeds=lambda obj, t: 100 
 
 def test_table_counts_and_wilson_bounds(tmp_path) -> None:
     _sweep(tmp_path, {"optimal": [True, False, False, True, False], "antipodal": [True] * 5})
-    md, table, drops = write_report(tmp_path, tmp_path / "out")
+    md, table, drops = write_comparison(tmp_path, tmp_path / "out")
     assert drops == []
     row = table.set_index("planner").loc["optimal"]
     assert (row.n, row.successes, row.success_pct) == (10, 4, 40.0)
@@ -67,7 +67,7 @@ def test_different_drops_are_reported(tmp_path) -> None:
     df, _ = collect_trials(tmp_path)
     drops = check_same_drops(df)
     assert len(drops) == 1 and "object=mug" in drops[0]
-    md, _, _ = write_report(tmp_path, tmp_path / "out")
+    md, _, _ = write_comparison(tmp_path, tmp_path / "out")
     assert "did not all run on the same drops" in md
 
 
@@ -78,7 +78,7 @@ def test_noise_levels_come_from_the_config_and_split_the_table(tmp_path) -> None
     df, warnings = collect_trials(tmp_path)
     assert warnings == []
     assert sorted(set(zip(df.trans_mm, df.rot_deg, strict=True))) == [(0.0, 0.0), (0.0, 5.0), (10.0, 0.0)]
-    _, table, _ = write_report(tmp_path, tmp_path / "out")
+    _, table, _ = write_comparison(tmp_path, tmp_path / "out")
     assert len(table) == 6 and set(table.n) == {4}
 
 

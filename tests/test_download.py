@@ -260,6 +260,7 @@ class _StallingHandler(SimpleHTTPRequestHandler):
         pass
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL], ids=["term", "kill"])
 def test_interrupted_download_leaves_no_temporary_file(server, tmp_path, sig):
     httpd = ThreadingHTTPServer(("127.0.0.1", 0), _StallingHandler)

@@ -15,7 +15,7 @@ from graspexp.report import collect
 from graspexp.report.gallery import _entities_at, key_times, pick_examples, write_gallery
 from graspexp.report.readings import MixedConfigError, readings_report
 
-pytestmark = pytest.mark.sim
+pytestmark = [pytest.mark.sim, pytest.mark.slow]
 REPO = Path(__file__).resolve().parent.parent
 OBJECTS = "objects=[box,block,mug]"
 

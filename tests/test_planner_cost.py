@@ -7,7 +7,7 @@ import pytest
 
 from graspexp.config import CostConfig
 from graspexp.planning.cost import (
-    cluster_costs,
+    all_path_costs,
     distance_term,
     path_main_axis_angles_deg,
     path_table_angles_rad,
@@ -16,6 +16,16 @@ from graspexp.planning.cost import (
 
 COST = CostConfig()
 G_M = 0.110
+
+
+def cluster_costs(points_m, center_m, r_k_m, directions, axis, mode, table_z_m, gripper_max_width_m, cost):
+    """Eq. (1) or (2) for the paths ``directions`` (M, 3) of one cluster: (M,) costs."""
+    d = np.asarray(directions, dtype=np.float64)[None]
+    feasible = np.ones(d.shape[:2], dtype=bool)
+    return all_path_costs(
+        points_m, center_m, [r_k_m], d, feasible, axis, mode, table_z_m, gripper_max_width_m, cost
+    )[0]
+
 
 # Collab case: path line = x axis through the centre (0, 0, 0); main axis 60 degrees from it.
 PATH_X = np.array([[1.0, 0.0, 0.0]])

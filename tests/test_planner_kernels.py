@@ -12,8 +12,8 @@ from test_planner_common import RG2
 import graspexp.planning.optimal as optimal
 from graspexp.cli import compose_config
 from graspexp.config import CostConfig, DatasetConfig, OptimalConfig
-from graspexp.config.gripper import finger_z_range_m
-from graspexp.datasets import load_object
+from graspexp.config.gripper import GripperGeometry
+from graspexp.datasets import dataset_objects, load_object
 from graspexp.datasets.catalog import candidate_paths
 from graspexp.plan import upright_pose
 from graspexp.planning import PlanRequest, plan
@@ -73,7 +73,8 @@ def slab_spans_reference(points_m, centers_m, rotations, gripper):
     rots = np.asarray(rotations, dtype=np.float64)
     centers = np.broadcast_to(np.asarray(centers_m, dtype=np.float64), (len(rots), 3))
     local = np.einsum("bji,bnj->bni", rots, np.asarray(points_m)[None] - centers[:, None])
-    z_lo, z_hi = finger_z_range_m(gripper)
+    geometry = GripperGeometry.of(gripper)
+    z_lo, z_hi = geometry.root_z_m, geometry.tip_z_m
     x, y, z = local[..., 0], local[..., 1], local[..., 2]
     inside = (np.abs(x) <= gripper.finger_width_m / 2) & (z >= z_lo) & (z <= z_hi)
     hi = np.where(inside, y, -np.inf).max(axis=1)
@@ -176,7 +177,7 @@ def test_kernel_cache_goes_to_the_graspexp_cache_and_survives_an_unwritable_one(
 def _objects(dataset: str, root) -> tuple[DatasetConfig, list[str]]:
     """The config's object list (paper Table 1 / Table 2) restricted to meshes present under ``root``."""
     cfg = DatasetConfig(name=dataset, root=str(root), regions=f"{dataset}.yaml")
-    names = list(compose_config([f"dataset={dataset}"]).dataset.objects)
+    names = dataset_objects(compose_config([f"dataset={dataset}"]).dataset)
     return cfg, [n for n in names if any(p.is_file() for p in candidate_paths(cfg, n))]
 
 

@@ -9,7 +9,7 @@ import pytest
 from test_planner_common import RG2
 
 from graspexp.config import CostConfig, DatasetConfig, OptimalConfig
-from graspexp.datasets import load_object
+from graspexp.datasets import dataset_objects, load_object
 from graspexp.datasets.catalog import candidate_paths, dataset_spec
 from graspexp.plan import main as plan_main
 from graspexp.plan import split_args, upright_pose
@@ -95,6 +95,7 @@ def test_plan_cli_prints_one_json_object_and_dumps(tmp_path, capsys, monkeypatch
     assert not list(tmp_path.glob("outputs"))  # compose API: no Hydra run folder
 
 
+@pytest.mark.slow
 def test_plan_cli_unknown_object_is_one_line_and_non_zero():
     proc = subprocess.run(
         [sys.executable, "-m", "graspexp.plan", "dataset=primitives", "object=teapot"],
@@ -131,7 +132,7 @@ def test_plan_latency_bench_prints_a_row_per_object_and_mode(capsys):
 
     assert main(["--repeats", "2", "--runs", "2", "dataset=primitives", "planner.m=64"]) == 0
     out = capsys.readouterr().out.splitlines()
-    objects = list(compose(["dataset=primitives"]).dataset.objects)
+    objects = dataset_objects(compose(["dataset=primitives"]).dataset)
     rows = [ln.split() for ln in out if ln.split() and ln.split()[0] in objects]
     assert [(r[0], r[1]) for r in rows] == [(o, m) for o in objects for m in MODES]
     for r in rows:  # wall p50, p95, CPU p50, p95, vs paper, K-means, Eq.1-3, ns/el

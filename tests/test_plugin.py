@@ -36,6 +36,7 @@ def _run(args: list[str], env: dict[str, str], cwd: Path) -> subprocess.Complete
     )
 
 
+@pytest.mark.slow
 @pytest.mark.sim
 def test_example_plugin_runs_through_the_benchmark_beside_a_builtin_planner(tmp_path):
     project = tomllib.loads((EXAMPLE / "pyproject.toml").read_text())["project"]
@@ -90,6 +91,7 @@ def test_example_plugin_runs_through_the_benchmark_beside_a_builtin_planner(tmp_
     assert again.returncode == 0 and (out / "top_down" / "summary.md").read_text() == summary
 
 
+@pytest.mark.slow
 def test_a_broken_or_unknown_plugin_is_one_line_naming_it(tmp_path):
     env = _register(tmp_path / "site", "broken-planner", "2.0", {"broken": "no_such_module:PLUGIN"})
     proc = _run(["graspexp", "planner=broken"], env, REPO)

@@ -15,6 +15,7 @@ from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory
 
 from graspexp.geometry import axis_angle_matrix, matrix_to_quat_wxyz
+from graspexp.outcome import FailureReason, TrialResult
 from graspexp.record import (
     CorruptLogError,
     OldLogFormatError,
@@ -26,7 +27,6 @@ from graspexp.record import (
 )
 from graspexp.record import schemas as S
 from graspexp.record.scene import box_entity, mesh_entity
-from graspexp.sim.outcome import FailureReason, TrialResult
 
 METADATA = {"config": "planner:\n  name: paper\n", "seed": "7", "versions": "graspexp=0.1.0"}
 RATE_HZ = 30
@@ -406,6 +406,7 @@ def _offsets(size: int) -> list[int]:
     return sorted(set(range(0, 200)) | set(range(200, size - 600, 7)) | set(range(max(size - 600, 0), size)))
 
 
+@pytest.mark.slow
 def test_truncations_of_a_small_log_are_corrupt(tmp_path):
     data = _small_log()
     bad = tmp_path / "cut.mcap"
@@ -416,6 +417,7 @@ def test_truncations_of_a_small_log_are_corrupt(tmp_path):
                 fn(bad)
 
 
+@pytest.mark.slow
 def test_byte_flips_are_corrupt(tmp_path):
     data = _small_log()
     bad = tmp_path / "flip.mcap"

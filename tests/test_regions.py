@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
@@ -14,16 +13,7 @@ from graspexp.datasets import DatasetError, available_objects, import_meshlab_ar
 from graspexp.datasets.catalog import DATASETS
 from graspexp.datasets.regions import REGIONS_DIR, apply_ops, load_region_specs
 
-REPO = Path(__file__).resolve().parents[1]
 UNIT_BOUNDS = np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]])
-
-
-@pytest.fixture(scope="module")
-def data_root() -> Path:
-    root = Path(os.environ.get("GRASPEXP_DATA") or REPO.parent / "shared" / "datasets")
-    if not (root / "ycb").is_dir():
-        pytest.skip(f"test meshes not found at {root}")
-    return root
 
 
 def specs_from(tmp_path: Path, text: str) -> dict:

@@ -6,12 +6,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from graspexp.datasets import dataset_objects
+from graspexp.outcome import FailureReason, TrialResult
 from graspexp.record import TrialRecorder
 from graspexp.report import build_report, collect, wilson_interval, write_report
 from graspexp.report.__main__ import main as report_main
 from graspexp.report.paper import BASELINES, SETTINGS, TABLE1, TABLE2
 from graspexp.report.render import display_frame, latex_escape
-from graspexp.sim.outcome import FailureReason, TrialResult
 from tests.conftest import compose_cfg
 
 # ---------------------------------------------------------------- Wilson interval (hand-computed)
@@ -56,9 +57,9 @@ def test_paper_averages_match_the_printed_rows(table) -> None:
 
 
 def test_paper_tables_use_the_dataset_object_ids() -> None:
-    """Row order and ids of paper.py are the config's object lists (paper Table 1 / 2 order)."""
-    assert list(TABLE1.labels) == list(compose_cfg("dataset=ycb").dataset.objects)
-    assert list(TABLE2.labels) == list(compose_cfg("dataset=linemod").dataset.objects)
+    """Row order and ids of paper.py are the datasets' default object lists (paper Table 1 / 2 order)."""
+    assert list(TABLE1.labels) == dataset_objects(compose_cfg("dataset=ycb").dataset)
+    assert list(TABLE2.labels) == dataset_objects(compose_cfg("dataset=linemod").dataset)
 
 
 # ---------------------------------------------------------------- a hand-made set of trial logs
@@ -188,6 +189,7 @@ def test_failure_breakdown_and_runtime(sweep_dir: Path) -> None:
     assert (rt.loc["ycb", "p50_ratio"], rt.loc["linemod", "p50_ratio"]) == pytest.approx((0.5, 2.0))
 
 
+@pytest.mark.slow
 def test_report_cli_writes_markdown_csv_latex_png(sweep_dir: Path, tmp_path: Path, capsys) -> None:
     out = tmp_path / "rep"
     assert report_main([str(sweep_dir), "--out", str(out)]) == 0
@@ -217,6 +219,7 @@ def test_report_cli_on_a_dir_without_logs_is_an_error(tmp_path: Path, capsys) ->
     assert "no trial logs" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_corrupt_and_unfinished_logs_are_named_not_dropped(sweep_dir: Path, tmp_path: Path, capsys) -> None:
     import shutil
 

@@ -13,9 +13,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from graspexp.outcome import FailureReason, TrialResult
 from graspexp.record import TrialRecorder, read_result
 from graspexp.runner import config_differences, job_lock, job_metadata, summarize
-from graspexp.sim.outcome import FailureReason, TrialResult
 from tests.conftest import compose_cfg
 
 REPO = Path(__file__).resolve().parent.parent
@@ -51,6 +51,7 @@ def run_copy(finished_run: Path, tmp_path: Path) -> Path:
     return out
 
 
+@pytest.mark.slow
 def test_resume_refuses_logs_made_with_another_config(run_copy: Path) -> None:
     log = run_copy / "trials" / "can" / "000.mcap"
     before = log.read_bytes()
@@ -62,6 +63,7 @@ def test_resume_refuses_logs_made_with_another_config(run_copy: Path) -> None:
     assert not (run_copy / "trials" / "can" / "001.mcap").exists()
 
 
+@pytest.mark.slow
 def test_resume_ignores_keys_that_do_not_change_a_result(run_copy: Path) -> None:
     log = run_copy / "trials" / "can" / "000.mcap"
     before = log.stat().st_mtime_ns
@@ -89,6 +91,7 @@ def test_config_differences_name_every_result_key_and_skip_neutral_ones() -> Non
         (("dataset.regions=nope.yaml", "objects=[can]"), "nope.yaml"),
     ],
 )
+@pytest.mark.slow
 def test_missing_input_stops_the_job_before_any_trial_is_recorded(
     tmp_path: Path, overrides: tuple[str, ...], message: str
 ) -> None:
@@ -100,6 +103,7 @@ def test_missing_input_stops_the_job_before_any_trial_is_recorded(
     assert not (run / "trials").exists() and not (run / "results.csv").exists()
 
 
+@pytest.mark.slow
 def test_error_trial_is_redone_on_resume(run_copy: Path) -> None:
     cfg = compose_cfg(*BASE)
     path = run_copy / "trials" / "can" / "000.mcap"
@@ -119,6 +123,7 @@ def test_error_trial_is_redone_on_resume(run_copy: Path) -> None:
     assert pd.read_csv(run_copy / "results.csv")["success"].tolist() == [old.success]
 
 
+@pytest.mark.slow
 def test_second_writer_into_a_locked_directory_is_one_line_naming_the_holder(tmp_path: Path) -> None:
     run = tmp_path / "run"
     with job_lock(run):
@@ -127,6 +132,7 @@ def test_second_writer_into_a_locked_directory_is_one_line_naming_the_holder(tmp
     assert not (run / "trials").exists()
 
 
+@pytest.mark.slow
 def test_unwritable_output_folder_is_one_line(tmp_path: Path) -> None:
     blocker = tmp_path / "file"
     blocker.write_text("")

@@ -5,13 +5,14 @@ import pytest
 
 from graspexp.datasets import load_object
 from graspexp.geometry import make_pose
+from graspexp.outcome import FailureReason
+from graspexp.planning import plan
 from graspexp.planning.grasp import Grasp
 from graspexp.planning.request import PlanResult
+from graspexp.quality import fc_min_mu
 from graspexp.seeding import derive_seed
-from graspexp.sim import trial as trial_mod
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.contacts import GRIPPER_LINKS
-from graspexp.sim.outcome import FailureReason
 from graspexp.sim.scene import SUPPORT_NAME
 from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial, trial_seed
 from tests.conftest import compose_cfg
@@ -34,12 +35,15 @@ class ContactCapture(NullRecorder):
         self.phases.append(name)
 
 
-def _ctx(*overrides, obj="can", trial=0, recorder=None):
+def _ctx(*overrides, obj="can", trial=0, recorder=None, planner=plan):
     cfg = compose_cfg("dataset=primitives", *overrides)
     plain = plain_config(cfg)
     model = load_object(cfg.dataset, obj, cfg.planner.n_points, derive_seed(cfg.seed, "cloud", obj))
     hulls = collision_shape(model.mesh, plain.sim)
-    return TrialContext(plain, model, hulls, trial, trial_seed(plain, obj, trial), recorder or NullRecorder())
+    seed = trial_seed(plain, obj, trial)
+    return TrialContext(
+        plain, model, hulls, trial, seed, recorder or NullRecorder(), plan=planner, quality=fc_min_mu
+    )
 
 
 # golden trials: fixed seeds whose drops the planner grasps (other seeds may fail for honest reasons)
@@ -69,35 +73,35 @@ def test_gripper_never_touches_the_box_in_collab_mode():
     assert any(set(p) & {"finger_left", "finger_right"} for p in pairs)
 
 
-def _fixed_planner(monkeypatch, pose_fn, width_m):
-    """Replace the planner by one that returns a deliberately chosen grasp."""
+def _fixed_planner(pose_fn, width_m):
+    """A planner that returns a deliberately chosen grasp."""
 
-    def fake_plan(req):
+    def fixed_plan(req):
         return PlanResult(Grasp(pose_fn(req), width_m, 0.0, 0, 0, 1, "fixed"))
 
-    monkeypatch.setattr(trial_mod, "plan", fake_plan)
+    return fixed_plan
 
 
 def _centre(req):
     return req.points.mean(axis=0)
 
 
-def test_approach_from_below_the_table_fails_with_collision_support(monkeypatch):
+def test_approach_from_below_the_table_fails_with_collision_support():
     # +Z (approach) points up: the gripper starts under the table and drives up through it
     R = np.array([[1.0, 0, 0], [0, -1.0, 0], [0, 0, 1.0]])
     R = np.stack([R[:, 0], np.cross(R[:, 2], R[:, 0]), R[:, 2]], axis=1)
-    _fixed_planner(monkeypatch, lambda req: make_pose(R, _centre(req)), 0.1)
-    res = run_trial(_ctx("mode=bin", "rot=z"))
+    fixed = _fixed_planner(lambda req: make_pose(R, _centre(req)), 0.1)
+    res = run_trial(_ctx("mode=bin", "rot=z", planner=fixed))
     assert res.reason == FailureReason.COLLISION_SUPPORT.value
     assert res.touched_support and not res.success
 
 
-def test_opening_narrower_than_the_object_fails(monkeypatch):
+def test_opening_narrower_than_the_object_fails():
     # top-down grasp of the upright can with a 1 cm opening: the fingers land on the lid
     X, Z = np.array([1.0, 0, 0]), np.array([0, 0, -1.0])
     R = np.stack([X, np.cross(Z, X), Z], axis=1)
-    _fixed_planner(monkeypatch, lambda req: make_pose(R, _centre(req)), 0.01)
-    res = run_trial(_ctx("mode=collab", "rot=z"))
+    fixed = _fixed_planner(lambda req: make_pose(R, _centre(req)), 0.01)
+    res = run_trial(_ctx("mode=collab", "rot=z", planner=fixed))
     assert res.reason == FailureReason.NO_CONTACT.value, res
 
 

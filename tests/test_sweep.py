@@ -56,6 +56,7 @@ def joblib_sweep(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
+@pytest.mark.slow
 def test_joblib_multirun_runs_each_setting_into_its_own_dir(joblib_sweep: Path) -> None:
     subdirs = sorted(p.name for p in joblib_sweep.iterdir() if p.is_dir())
     assert subdirs == [
@@ -71,6 +72,7 @@ def test_joblib_multirun_runs_each_setting_into_its_own_dir(joblib_sweep: Path) 
         assert len(csv) == 6
 
 
+@pytest.mark.slow
 def test_sweep_killed_midway_and_resumed_equals_an_uninterrupted_one(
     joblib_sweep: Path, tmp_path: Path
 ) -> None:
@@ -102,6 +104,7 @@ def test_sweep_killed_midway_and_resumed_equals_an_uninterrupted_one(
     pd.testing.assert_frame_equal(_table(out), _table(joblib_sweep))
 
 
+@pytest.mark.slow
 def test_submitit_local_launcher(tmp_path: Path) -> None:
     out = tmp_path / "submitit"
     cmd = [
@@ -116,6 +119,7 @@ def test_submitit_local_launcher(tmp_path: Path) -> None:
     assert table[["mode", "object", "trial"]].values.tolist() == [["collab", "can", 0]]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("launcher", ["basic", "joblib"])
 def test_a_job_that_cannot_run_does_not_stop_the_sweep(tmp_path: Path, launcher: str) -> None:
     out, empty = tmp_path / "sweep", tmp_path / "empty"
@@ -136,6 +140,7 @@ def test_a_job_that_cannot_run_does_not_stop_the_sweep(tmp_path: Path, launcher:
     assert not (out / bad / "trials").exists()
 
 
+@pytest.mark.slow
 def test_long_sweep_values_get_short_unique_dir_names_and_resume(tmp_path: Path) -> None:
     out = tmp_path / "sweep"
     roots = [f"/{c * 300}" for c in "ab"]  # the primitives ignore the data root: any value runs

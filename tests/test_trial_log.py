@@ -10,13 +10,15 @@ from conftest import compose_cfg, strictly_valid
 from mcap.reader import make_reader
 
 from graspexp.datasets import load_object
+from graspexp.planning import plan
+from graspexp.quality import fc_min_mu
 from graspexp.record import TrialRecorder, read_trial
 from graspexp.record.scene import object_scene
 from graspexp.seeding import derive_seed
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
 
-pytestmark = pytest.mark.sim
+pytestmark = [pytest.mark.sim, pytest.mark.slow]
 REPO = Path(__file__).resolve().parent.parent
 WALL_CLOCK_KEYS = {"timings_s"}
 """Result fields that hold wall-clock time: the only payload bytes allowed to differ between two runs."""
@@ -129,7 +131,15 @@ def collab_log(tmp_path_factory) -> Path:
     path = tmp_path_factory.mktemp("collab") / "000.mcap"
     with TrialRecorder(path, {"object": name}) as rec:
         ctx = TrialContext(
-            plain, model, hulls, 0, trial_seed(plain, name, 0), rec, object_scene(plain, hulls)
+            plain,
+            model,
+            hulls,
+            0,
+            trial_seed(plain, name, 0),
+            rec,
+            object_scene(plain, hulls),
+            plan=plan,
+            quality=fc_min_mu,
         )
         run_trial(ctx)
     return path

@@ -29,7 +29,9 @@ from threadpoolctl import threadpool_limits
 
 from graspexp.cli import compose_config
 from graspexp.datasets import load_object
+from graspexp.planning import plan
 from graspexp.prepare import staged_objects
+from graspexp.quality import fc_min_mu
 from graspexp.seeding import derive_seed
 from graspexp.sim.collision_accuracy import shape_accuracy, surface_points, uncovered_m
 from graspexp.sim.collision_shapes import collision_shape
@@ -73,7 +75,18 @@ def measure(overrides: list[str], dataset: str, name: str, trials: int, samples:
         cook, rest = _rest_scene(shape, model.mesh, model.mass_kg, plain)
         per_step, ok = [], 0
         for i in range(trials):
-            res = run_trial(TrialContext(plain, model, shape, i, trial_seed(plain, name, i), NullRecorder()))
+            res = run_trial(
+                TrialContext(
+                    plain,
+                    model,
+                    shape,
+                    i,
+                    trial_seed(plain, name, i),
+                    NullRecorder(),
+                    plan=plan,
+                    quality=fc_min_mu,
+                )
+            )
             ok += res.success
             if res.steps:
                 per_step.append(res.timings_s["physics"] / res.steps * 1e6)

@@ -34,6 +34,7 @@ import numba  # noqa: E402
 import numpy as np  # noqa: E402
 from threadpoolctl import threadpool_limits  # noqa: E402
 
+from graspexp.datasets import dataset_objects  # noqa: E402
 from graspexp.plan import CliError, compose, load, upright_request  # noqa: E402
 from graspexp.planning import PlanRequest, kernels, plan  # noqa: E402
 from graspexp.planning.clusters import segment  # noqa: E402
@@ -129,13 +130,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         cfg = compose(["dataset=ycb", *overrides])
         dataset = str(cfg.dataset.name)
-        names = list(cfg.dataset.objects)
+        names = dataset_objects(cfg.dataset)
         try:
             load(cfg, names[0])
         except CliError as err:
             print(f"note: {dataset} meshes unavailable ({err}); falling back to the primitives dataset")
             cfg = compose([*overrides, "dataset=primitives"])
-            dataset, names = "primitives", list(cfg.dataset.objects)
+            dataset, names = "primitives", dataset_objects(cfg.dataset)
         rows = []  # (name, mode, K, area size, request)
         first = None
         for name in names:

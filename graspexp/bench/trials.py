@@ -22,6 +22,8 @@ from threadpoolctl import threadpool_limits
 
 from graspexp.cli import compose_config
 from graspexp.datasets import available_objects, load_object
+from graspexp.planning import plan
+from graspexp.quality import fc_min_mu
 from graspexp.record import TrialRecorder
 from graspexp.record.scene import object_scene
 from graspexp.seeding import derive_seed
@@ -69,11 +71,27 @@ class _Object:
         seed = trial_seed(self.plain, self.name, i)
         t0, c0 = time.perf_counter(), time.thread_time()
         if out is None:
-            res = run_trial(TrialContext(self.plain, self.model, self.hulls, i, seed, NullRecorder()))
+            res = run_trial(
+                TrialContext(
+                    self.plain, self.model, self.hulls, i, seed, NullRecorder(), plan=plan, quality=fc_min_mu
+                )
+            )
         else:
             path = Path(out) / self.name / f"{i:03d}.mcap"
             with _TimedRecorder(path, {"object": self.name}) as rec:
-                res = run_trial(TrialContext(self.plain, self.model, self.hulls, i, seed, rec, self.scene))
+                res = run_trial(
+                    TrialContext(
+                        self.plain,
+                        self.model,
+                        self.hulls,
+                        i,
+                        seed,
+                        rec,
+                        self.scene,
+                        plan=plan,
+                        quality=fc_min_mu,
+                    )
+                )
             spent = rec.spent
         wall, cpu = time.perf_counter() - t0, time.thread_time() - c0
         ticks = {} if out is None else {f"tick_{k}": v for k, v in spent.items()}

@@ -11,7 +11,7 @@ from graspexp.compare.report import (
     plot_success_vs_noise,
     render_markdown,
     success_table,
-    write_report,
+    write_comparison,
 )
 
 __all__ = [
@@ -22,5 +22,5 @@ __all__ = [
     "plot_success_vs_noise",
     "render_markdown",
     "success_table",
-    "write_report",
+    "write_comparison",
 ]

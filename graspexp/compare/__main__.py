@@ -8,7 +8,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from graspexp.compare.report import write_report
+from graspexp.compare.report import write_comparison
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -19,7 +19,7 @@ def main(argv: list[str] | None = None) -> int:
     if not args.dir.is_dir():
         print(f"graspexp.compare: error: {args.dir} is not a directory", file=sys.stderr)
         return 2
-    md, table, _ = write_report(args.dir, args.out)
+    md, table, _ = write_comparison(args.dir, args.out)
     print(md, end="")
     if table.empty:
         print(f"graspexp.compare: error: no readable trial log below {args.dir}", file=sys.stderr)

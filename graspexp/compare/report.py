@@ -4,7 +4,7 @@ Rows come from each log's ``/result`` (:func:`graspexp.record.read_result`) plus
 of its run, read from the ``config_yaml`` entry of the log's ``graspexp`` metadata record
 (``perception.noise.trans_mm``, mm, and ``perception.noise.rot_deg``, degrees; 0 when absent).
 
-Outputs of :func:`write_report` (in ``OUT``):
+Outputs of :func:`write_comparison` (in ``OUT``):
 
 - ``compare.csv``: one row per (dataset, mode, rot, trans_mm, rot_deg, planner): trials ``n``,
   ``successes``, ``success_pct`` and the Wilson 95 % interval ``ci_lo_pct``, ``ci_hi_pct``;
@@ -234,7 +234,7 @@ def plot_success_vs_noise(df: pd.DataFrame, path: Path | str) -> None:
     plt.close(fig)
 
 
-def write_report(root: Path | str, out: Path | str | None = None) -> tuple[str, pd.DataFrame, list[str]]:
+def write_comparison(root: Path | str, out: Path | str | None = None) -> tuple[str, pd.DataFrame, list[str]]:
     """Collect, tabulate, check and plot; write compare.md, compare.csv, success_vs_noise.png to ``out``
     (default ``<root>/compare``). Returns (markdown, table, same-drop warnings)."""
     root = Path(root)

@@ -16,7 +16,9 @@ class DatasetConfig:
     root: str | None = None
     """Data root folder. None: env ``GRASPEXP_DATA``, else ``datasets/`` in the working directory."""
     objects: list[str] = field(default_factory=list)
-    """The dataset's object list (paper Table 1 / Table 2 order); ``objects=[...]`` at top level subsets it."""
+    """The objects of a run; empty (the shipped options): the dataset's default list, paper Table 1 / Table 2
+    order (:data:`graspexp.datasets.catalog.DATASETS`, the one place it is written); ``objects=[...]`` at
+    top level subsets it."""
     density_kg_m3: float = 700.0
     """Density used for the mass when the dataset publishes none (LINEMOD, primitives), kg/m^3."""
     regions: str = MISSING

@@ -5,6 +5,7 @@ Gripper frame (paper Fig. 9): +Z approach, +Y closing axis, origin midway betwee
 
 from dataclasses import dataclass
 
+import numpy as np
 from omegaconf import MISSING
 
 from graspexp.config.constraints import TEXT, Interval, Vector
@@ -35,10 +36,74 @@ class GripperConfig:
     """Distance from the fingertips back to the TCP (the grasp point, the pads' centre) along -Z, m."""
 
 
-def finger_z_range_m(g: GripperConfig) -> tuple[float, float]:
-    """(z_min, z_max) of the fingers along the approach axis in the gripper frame, m: from the palm face
-    (z_min, where the palm box starts and extends further back by palm_size_m[2]) to the tips (z_max)."""
-    return g.tcp_from_tip_m - g.finger_length_m, g.tcp_from_tip_m
+@dataclass(frozen=True)
+class Box:
+    """An axis-aligned box: centre (3,) and full size (3,), m, in the frame its owner names."""
+
+    center: tuple[float, float, float]
+    size: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class GripperGeometry:
+    """The finger and palm boxes of a parallel-jaw gripper: the one description the planner's collision
+    checks, the simulated articulation, the log's scene and the figures all use.
+
+    Gripper frame: +Z approach, +X main axis, +Y closing axis, origin midway between the pads (the TCP).
+    The fingers span ``root_z_m`` (the palm face) to ``tip_z_m`` (the fingertips) along Z; the palm box
+    lies behind the palm face.
+    """
+
+    finger_width_m: float
+    """Along X, m."""
+    finger_thickness_m: float
+    """Along Y, m."""
+    finger_length_m: float
+    """Along Z, m."""
+    palm_size_m: tuple[float, float, float]
+    """Full size along X, Y, Z, m."""
+    root_z_m: float
+    """Z of the palm face, where the fingers start, m."""
+    tip_z_m: float
+    """Z of the fingertips, m (``tcp_from_tip_m`` in front of the TCP)."""
+
+    @classmethod
+    def of(cls, g: GripperConfig) -> "GripperGeometry":
+        """The geometry of gripper config ``g``."""
+        return cls(
+            g.finger_width_m,
+            g.finger_thickness_m,
+            g.finger_length_m,
+            tuple(float(v) for v in g.palm_size_m),
+            g.tcp_from_tip_m - g.finger_length_m,
+            g.tcp_from_tip_m,
+        )
+
+    def palm(self) -> Box:
+        """The palm box in the gripper frame."""
+        px, py, pz = self.palm_size_m
+        return Box((0.0, 0.0, self.root_z_m - pz / 2), (px, py, pz))
+
+    def finger(self, side: float) -> Box:
+        """The box of one finger in its own link frame, whose origin is the centre of the pad face (the
+        finger's inner face); ``side`` +1 for the left finger (+Y side), -1 for the right."""
+        t, L = self.finger_thickness_m, self.finger_length_m
+        return Box((0.0, side * t / 2, self.root_z_m + L / 2), (self.finger_width_m, t, L))
+
+    def boxes(self, width_m: float) -> np.ndarray:
+        """(3, 2, 3) float64 ``[lo, hi]`` corners of the left finger, right finger and palm in the gripper
+        frame, pads ``width_m`` apart, m."""
+        fw, t = self.finger_width_m, self.finger_thickness_m
+        px, py, pz = self.palm_size_m
+        root, tip = self.root_z_m, self.tip_z_m
+        h = width_m / 2
+        return np.array(
+            [
+                [[-fw / 2, h, root], [fw / 2, h + t, tip]],
+                [[-fw / 2, -h - t, root], [fw / 2, -h, tip]],
+                [[-px / 2, -py / 2, root - pz], [px / 2, py / 2, root]],
+            ]
+        )
 
 
 CONSTRAINTS = {

@@ -45,7 +45,7 @@ def register_configs() -> None:
     ``planner/base_<name>`` plus, unless ``conf/planner/<name>.yaml`` is its preset, the option
     ``planner/<name>`` (the schema's defaults); safe to call twice. Broken plugins are skipped here (their
     error is raised when one is selected, see :func:`graspexp.config.plugins.get_plugin`)."""
-    from hydra.core.config_store import ConfigStore
+    from hydra.core.config_store import ConfigStore  # here, so that the schemas load without Hydra
 
     cs = ConfigStore.instance()
     cs.store(name="base_job", node=JobConfig)

@@ -15,7 +15,7 @@ Public API (the simulator and planner import these names)::
 from graspexp.datasets import primitives
 from graspexp.datasets.catalog import available_objects, dataset_objects, resolve_root
 from graspexp.datasets.errors import DatasetError
-from graspexp.datasets.loader import load_object
+from graspexp.datasets.loader import load_object, select_objects
 from graspexp.datasets.model import ObjectModel
 from graspexp.datasets.regions import import_meshlab_area
 
@@ -28,4 +28,5 @@ __all__ = [
     "load_object",
     "primitives",
     "resolve_root",
+    "select_objects",
 ]

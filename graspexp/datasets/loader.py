@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import logging
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,8 +16,10 @@ from graspexp.datasets.catalog import (
     LINEMOD_IDS,
     LINEMOD_MM_TO_M,
     YCB_MASS_KG,
+    available_objects,
     check_object_name,
     dataset_dir,
+    dataset_objects,
     mesh_path,
     resolve_root,
 )
@@ -25,6 +28,8 @@ from graspexp.datasets.meshcheck import check_bop_info, check_file, check_geomet
 from graspexp.datasets.model import ObjectModel
 from graspexp.datasets.primitives import PRIMITIVES
 from graspexp.datasets.regions import area_mask, load_region_specs, regions_path
+
+log = logging.getLogger(__name__)
 
 MIN_VOLUME_M3 = 1e-9
 """A mesh whose convex hull encloses less than this (1 mm^3) is degenerate (flat or a point)."""
@@ -164,3 +169,28 @@ def load_object(cfg: Any, name: str, n_points: int, seed: int) -> ObjectModel:
         mass_kg=object_mass_kg(cfg, name, entry),
         source=source,
     )
+
+
+def select_objects(dataset: Any, objects: list[str] | None) -> list[str]:
+    """The objects to run: ``objects`` if given (each must exist), else the dataset's list less the objects
+    whose files are missing (named in a warning with the download command). ``dataset``: the job's
+    ``dataset`` config."""
+    names = dataset_objects(dataset)
+    if objects:
+        unknown = [o for o in objects if o not in names]
+        if unknown:
+            raise DatasetError(f"unknown object(s) {unknown} in dataset {dataset.name!r}; valid: {names}")
+        return list(objects)
+    present = available_objects(dataset)
+    if not present:
+        load_object(dataset, names[0], 16, 0)  # raises the DatasetError that names the missing path
+    missing = [o for o in names if o not in present]
+    if missing:
+        log.warning(
+            "dataset %s: no mesh for %s under the data root; skipping them (get them with "
+            "`python -m graspexp.download dataset=%s`)",
+            dataset.name,
+            missing,
+            dataset.name,
+        )
+    return [o for o in names if o in present]

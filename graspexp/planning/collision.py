@@ -4,7 +4,7 @@ Shared by the ``antipodal``, ``obb``, ``random`` and ``optimal_plus`` planners. 
 
 Geometry (the same as :mod:`graspexp.sim.gripper`), in the grasp frame (+Z approach, +Y closing axis,
 origin midway between the pads), for an opening ``w``, finger span ``[z0, z1]`` along Z
-(:func:`graspexp.config.gripper.finger_z_range_m`: palm face to fingertips), width ``fw`` (X),
+(:class:`graspexp.config.gripper.GripperGeometry`: palm face to fingertips), width ``fw`` (X),
 thickness ``t`` (Y) and palm size ``(px, py, pz)``:
 
 - left finger  ``x in [-fw/2, fw/2]``, ``y in [ w/2,  w/2 + t]``, ``z in [z0, z1]``;
@@ -26,30 +26,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from graspexp.config import GripperConfig
-from graspexp.config.gripper import finger_z_range_m
+from graspexp.config.gripper import GripperGeometry
 
 POSE_BATCH = 128
 """Poses per vectorised block in :func:`cloud_hits` (bounds memory at ~POSE_BATCH x N x 3 floats)."""
-
-
-def gripper_boxes(gripper: GripperConfig, width_m: float) -> np.ndarray:
-    """(3, 2, 3) float64 ``[lo, hi]`` corners of the left finger, right finger and palm, grasp frame, m."""
-    fw, t = gripper.finger_width_m, gripper.finger_thickness_m
-    px, py, pz = (float(v) for v in gripper.palm_size_m)
-    root, tip = finger_z_range_m(gripper)
-    h = width_m / 2
-    return np.array(
-        [
-            [[-fw / 2, h, root], [fw / 2, h + t, tip]],
-            [[-fw / 2, -h - t, root], [fw / 2, -h, tip]],
-            [[-px / 2, -py / 2, root - pz], [px / 2, py / 2, root]],
-        ]
-    )
-
-
-def fingertip_z_offset_m(gripper: GripperConfig) -> float:
-    """How far the fingertips reach past the grasp point along +Z, m (``gripper.tcp_from_tip_m``)."""
-    return finger_z_range_m(gripper)[1]
 
 
 def lowest_z(poses: np.ndarray, gripper: GripperConfig, widths_m: np.ndarray, sweep_m: float) -> np.ndarray:
@@ -66,8 +46,9 @@ def lowest_z(poses: np.ndarray, gripper: GripperConfig, widths_m: np.ndarray, sw
     out = np.empty(len(poses))
     pick = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])  # 8 corners: lo/hi per axis
     back = np.array([0.0, 0.0, sweep_m])
+    geometry = GripperGeometry.of(gripper)
     for b, (pose, w) in enumerate(zip(poses, widths, strict=True)):
-        boxes = gripper_boxes(gripper, float(w))  # (3, 2, 3)
+        boxes = geometry.boxes(float(w))  # (3, 2, 3)
         corners = boxes[:, pick, np.arange(3)].reshape(-1, 3)  # (24, 3) grasp frame
         ends = np.concatenate([corners, corners - back])  # grasp and pre-grasp ends of the approach
         out[b] = float((ends @ pose[:3, :3].T + pose[:3, 3])[:, 2].min())
@@ -94,8 +75,8 @@ def closing_section(
     -------
     lo, hi : (B,) float64, metres; both 0 where no point is in reach.
     """
-    fw = gripper.finger_width_m
-    root, tip = finger_z_range_m(gripper)
+    geometry = GripperGeometry.of(gripper)
+    fw, root, tip = geometry.finger_width_m, geometry.root_z_m, geometry.tip_z_m
     x, y, z = local[..., 0], local[..., 1], local[..., 2]
     reach = (np.abs(x) <= fw / 2 + margin_m) & (z >= root - margin_m) & (z <= tip + margin_m)
     hi = np.where(reach, y, -np.inf).max(axis=1)
@@ -124,9 +105,10 @@ def cloud_hits(
     poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)
     widths = np.broadcast_to(np.asarray(widths_m, dtype=np.float64), (len(poses),))
     out = np.zeros(len(poses), dtype=np.int64)
-    fw, t = gripper.finger_width_m, gripper.finger_thickness_m
-    px, py, pz = (float(v) for v in gripper.palm_size_m)
-    root, tip = finger_z_range_m(gripper)
+    geometry = GripperGeometry.of(gripper)
+    fw, t = geometry.finger_width_m, geometry.finger_thickness_m
+    px, py, pz = geometry.palm_size_m
+    root, tip = geometry.root_z_m, geometry.tip_z_m
     m = margin_m
     for s in range(0, len(poses), POSE_BATCH):
         local = local_coords(points_m, poses[s : s + POSE_BATCH])
@@ -300,12 +282,12 @@ def place_grasps(
 
 MAX_LIFT_FRACTION = 0.8
 """A grasp may move back from its grasp point by at most this fraction of the fingertip reach
-(:func:`fingertip_z_offset_m`), so the point it aimed at stays between the pads."""
+(:attr:`GripperGeometry.tip_z_m`), so the point it aimed at stays between the pads."""
 
 
 def max_lift_m(gripper: GripperConfig) -> float:
     """Largest back-off along -Z that :func:`place_grasps` may apply to clear the support, m."""
-    return MAX_LIFT_FRACTION * fingertip_z_offset_m(gripper)
+    return MAX_LIFT_FRACTION * GripperGeometry.of(gripper).tip_z_m
 
 
 def place_for_request(req, poses: np.ndarray, min_widths_m: np.ndarray | float = 0.0) -> Placement:

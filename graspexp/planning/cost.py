@@ -192,32 +192,3 @@ def all_path_costs(
             j[k] *= table_term(d_k_mm, beta[k], gripper_max_width_m * M_TO_MM, cost)
     j[~feasible] = np.inf
     return j
-
-
-def cluster_costs(
-    points_m: np.ndarray,
-    center_m: np.ndarray,
-    r_k_m: float,
-    directions: np.ndarray,
-    axis: np.ndarray,
-    mode: str,
-    table_z_m: float,
-    gripper_max_width_m: float,
-    cost: CostConfig,
-    *,
-    dtype: type = np.float32,
-) -> np.ndarray:
-    """Eq. (1) (``mode == "collab"``) or Eq. (2) (``mode == "bin"``) for the paths of one cluster.
-
-    points_m : (N, 3) whole object cloud, world, metres; center_m : (3,) c_k; r_k_m : radius, metres;
-    directions : (M, 3) unit approach directions; axis : (3,) unit main axis.
-
-    Returns
-    -------
-    (M,) float64 costs (finite; feasibility is the caller's business).
-    """
-    d = np.asarray(directions, dtype=np.float64)[None]
-    ones = np.ones(d.shape[:2], dtype=bool)
-    return all_path_costs(
-        points_m, center_m, [r_k_m], d, ones, axis, mode, table_z_m, gripper_max_width_m, cost, dtype=dtype
-    )[0]

@@ -12,7 +12,7 @@ Width
 
 Section between the pads
     In the grasp frame, take the object points inside the pads' sweep: ``|x| <= finger_width/2`` and
-    ``z`` within the fingers' extent (:func:`graspexp.config.gripper.finger_z_range_m`). Their span ``[y_lo, y_hi]`` along the
+    ``z`` within the fingers' extent (:class:`graspexp.config.gripper.GripperGeometry`). Their span ``[y_lo, y_hi]`` along the
     closing axis is the section the fingers close on (:func:`slab_spans_m`); its extent
     ``y_hi - y_lo`` is the opening it needs. The pads close symmetrically, so the planner moves the
     grasp point along Y to the section's middle, ``c_k + (y_lo + y_hi)/2 * Y`` (the paper's c_k is a
@@ -27,7 +27,7 @@ Section between the pads
 import numpy as np
 
 from graspexp.config import GripperConfig
-from graspexp.config.gripper import finger_z_range_m
+from graspexp.config.gripper import GripperGeometry
 from graspexp.planning.kernels import grasp_frames, slab_spans
 
 PARALLEL_TOL = 1e-6
@@ -78,12 +78,12 @@ def slab_spans_m(
     """
     rots = np.ascontiguousarray(rotations, dtype=np.float64)
     centers = np.ascontiguousarray(np.broadcast_to(np.asarray(centers_m, dtype=np.float64), (len(rots), 3)))
-    z_lo, z_hi = finger_z_range_m(gripper)
+    geometry = GripperGeometry.of(gripper)
     return slab_spans(
         np.ascontiguousarray(points_m, dtype=np.float64),
         centers,
         rots,
-        gripper.finger_width_m / 2,
-        z_lo,
-        z_hi,
+        geometry.finger_width_m / 2,
+        geometry.root_z_m,
+        geometry.tip_z_m,
     )

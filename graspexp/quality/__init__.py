@@ -3,8 +3,9 @@
 from graspexp.quality.force_closure import (
     DEFAULT_MUS,
     contacts_for_grasp,
+    fc_min_mu,
     grasp_quality,
     min_friction_for_closure,
 )
 
-__all__ = ["DEFAULT_MUS", "contacts_for_grasp", "grasp_quality", "min_friction_for_closure"]
+__all__ = ["DEFAULT_MUS", "contacts_for_grasp", "fc_min_mu", "grasp_quality", "min_friction_for_closure"]

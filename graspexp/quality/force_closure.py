@@ -121,6 +121,12 @@ def contacts_for_grasp(
     return p1, n1 / np.linalg.norm(n1), p2, n2 / np.linalg.norm(n2)
 
 
+def fc_min_mu(mesh: trimesh.Trimesh, grasp: Grasp) -> float:
+    """Smallest friction coefficient of :data:`DEFAULT_MUS` at which ``grasp`` is force-closure on ``mesh``
+    (both in the same frame); inf when none is or the closing line misses the mesh."""
+    return grasp_quality(mesh, grasp)["fc_min_mu"]
+
+
 def grasp_quality(mesh_world: trimesh.Trimesh, grasp: Grasp, mus: tuple[float, ...] = DEFAULT_MUS) -> dict:
     """Physics-free quality of a planned grasp, for the trial log.
 

@@ -8,12 +8,14 @@ built by :mod:`graspexp.record.scene` (imported on its own: it needs the simulat
 """
 
 from graspexp.record.reader import (
+    TRIALS_DIR,
     CorruptLogError,
     OldLogFormatError,
     TrialLog,
     iter_trial_logs,
     read_result,
     read_trial,
+    trial_log_path,
 )
 from graspexp.record.writer import TrialRecorder, TrialWriter, trial_recorder
 
@@ -23,8 +25,10 @@ __all__ = [
     "TrialLog",
     "TrialRecorder",
     "TrialWriter",
+    "TRIALS_DIR",
     "iter_trial_logs",
     "read_result",
     "read_trial",
+    "trial_log_path",
     "trial_recorder",
 ]

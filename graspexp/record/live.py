@@ -8,7 +8,7 @@ clock at 0 (log time is simulation time). Off by default; when off no server is 
 
 import foxglove
 
-from graspexp.record.writer import Channels
+from graspexp.record.channels import Channels
 
 HOST = "127.0.0.1"
 _SERVERS: dict[int, tuple[foxglove.WebSocketServer, Channels]] = {}

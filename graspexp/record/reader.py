@@ -401,11 +401,20 @@ def _trial_sort_key(p: Path) -> tuple:
     return (p.parent.name, 0, int(stem), "") if stem.isdigit() else (p.parent.name, 1, 0, stem)
 
 
+TRIALS_DIR = "trials"
+"""The folder of a run directory that holds its trial logs, ``trials/<object>/<NNN>.mcap``."""
+
+
+def trial_log_path(run_dir: Path | str, object_name: str, trial: int) -> Path:
+    """Where trial ``trial`` of ``object_name`` is logged in ``run_dir``."""
+    return Path(run_dir) / TRIALS_DIR / object_name / f"{trial:03d}.mcap"
+
+
 def iter_trial_logs(run_dir: Path | str) -> Iterator[Path]:
     """Finished logs ``<run_dir>/trials/<object>/<index>.mcap``, by object then numeric index.
 
     ``.partial`` files (unfinished trials) are skipped.
     """
-    trials = Path(run_dir) / "trials"
+    trials = Path(run_dir) / TRIALS_DIR
     paths = [p for p in trials.glob("*/*.mcap") if p.is_file() and not p.name.endswith(S.PARTIAL_SUFFIX)]
     yield from sorted(paths, key=_trial_sort_key)

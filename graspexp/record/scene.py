@@ -23,7 +23,7 @@ from foxglove.messages import (
 )
 
 from graspexp.config import JobConfig
-from graspexp.config.gripper import finger_z_range_m
+from graspexp.config.gripper import GripperGeometry
 from graspexp.sim.collision_shapes import hull_meshes
 from graspexp.sim.gripper import FINGER_NAMES, PALM_NAME
 from graspexp.sim.scene import OBJECT_NAME, SUPPORT_NAME
@@ -125,12 +125,10 @@ def object_scene(cfg: JobConfig, hulls: list[np.ndarray]) -> ObjectScene:
     static = [box_entity(SUPPORT_NAME, "world", [0.0, 0.0, h / 2], [2 * hx, 2 * hy, h], SUPPORT_COLOR)]
     for i, m in enumerate(hull_meshes(hulls)):
         static.append(mesh_entity(f"{OBJECT_NAME}_hull_{i}", OBJECT_NAME, m.vertices, m.faces, HULL_COLOR))
-    g = cfg.gripper
-    L, t = g.finger_length_m, g.finger_thickness_m
-    root_z, _ = finger_z_range_m(g)
-    px, py, pz = g.palm_size_m
-    gripper = [box_entity(PALM_NAME, PALM_NAME, [0.0, 0.0, root_z - pz / 2], [px, py, pz], GRIPPER_COLOR)]
+    geometry = GripperGeometry.of(cfg.gripper)
+    palm = geometry.palm()
+    gripper = [box_entity(PALM_NAME, PALM_NAME, list(palm.center), list(palm.size), GRIPPER_COLOR)]
     for name, sign in zip(FINGER_NAMES, (1.0, -1.0), strict=True):
-        center = [0.0, sign * t / 2, root_z + L / 2]
-        gripper.append(box_entity(name, name, center, [g.finger_width_m, t, L], GRIPPER_COLOR))
+        finger = geometry.finger(sign)
+        gripper.append(box_entity(name, name, list(finger.center), list(finger.size), GRIPPER_COLOR))
     return ObjectScene(static=static, gripper=gripper)

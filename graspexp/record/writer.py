@@ -30,12 +30,6 @@ from typing import IO, TYPE_CHECKING, Any
 
 import foxglove
 import numpy as np
-from foxglove.channels import (
-    FrameTransformsChannel,
-    PointCloudChannel,
-    PoseInFrameChannel,
-    SceneUpdateChannel,
-)
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 from foxglove.messages import (
     FrameTransform,
@@ -56,6 +50,8 @@ from foxglove.messages import (
 
 from graspexp.geometry import matrix_to_quat_wxyz
 from graspexp.record import schemas as S
+from graspexp.record.channels import Channels, body_names
+from graspexp.record.live import live_channels
 
 if TYPE_CHECKING:
     from graspexp.config import JobConfig
@@ -112,39 +108,6 @@ def to_json_value(value: Any) -> Any:
     raise TypeError(f"cannot encode {type(value).__name__} value {value!r} as JSON")
 
 
-class Channels:
-    """Every channel of a trial log on one ``foxglove.Context`` (its sinks: an MCAP file, a live server)."""
-
-    def __init__(self, context: foxglove.Context):
-        self.context = context
-        self.tf = FrameTransformsChannel(S.TOPIC_TF, context=context)
-        self.contacts = PointCloudChannel(
-            S.TOPIC_CONTACTS, metadata={"bodies": ",".join(body_names())}, context=context
-        )
-        self.scene = SceneUpdateChannel(S.TOPIC_SCENE, context=context)
-        self.grasp_pose = PoseInFrameChannel(S.TOPIC_GRASP_POSE, context=context)
-        self.json = {
-            topic: foxglove.Channel(
-                topic,
-                schema=foxglove.Schema(name=name, encoding=S.SCHEMA_ENCODING, data=S.schema_bytes(name)),
-                message_encoding=S.MESSAGE_ENCODING,
-                context=context,
-            )
-            for topic, name in S.TOPIC_SCHEMAS.items()
-            if name in S.SCHEMAS
-        }
-
-
-@functools.cache
-def body_names() -> tuple[str, ...]:
-    """The physics bodies that can touch, in /contacts index order (imported here, not at module level, so
-    that reading logs does not load the simulator)."""
-    from graspexp.sim.gripper import FINGER_NAMES, PALM_NAME
-    from graspexp.sim.scene import GROUND_NAME, OBJECT_NAME, SUPPORT_NAME
-
-    return (OBJECT_NAME, SUPPORT_NAME, GROUND_NAME, PALM_NAME, *FINGER_NAMES)
-
-
 @functools.cache
 def _body_ids() -> dict[str, int]:
     return {name: i for i, name in enumerate(body_names())}
@@ -181,6 +144,9 @@ class TrialWriter:
     channels of a live server (:func:`graspexp.record.live.live_channels`) that also get every message;
     None: the file only. ``stream=None`` with live channels streams without writing a file.
     """
+
+    active = True
+    """Every message is kept (:class:`graspexp.sim.trial.TrialLog`)."""
 
     def __init__(
         self, stream: IO[bytes] | None, metadata: Mapping[str, str], channels: Channels | None = None
@@ -405,8 +371,6 @@ def trial_recorder(
     """
     channels = None
     if cfg.live:
-        from graspexp.record.live import live_channels
-
         channels = live_channels(int(cfg.live_port))
     if path is not None:
         return TrialRecorder(path, metadata, channels)

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from graspexp.report.charts import success_chart
 from graspexp.report.collect import Collected, collect
-from graspexp.report.figures import success_chart
 from graspexp.report.gallery import write_gallery
 from graspexp.report.paper import PLANNER_RUNTIME_S
 from graspexp.report.render import display_frame, fmt_pct, footnotes, latex, markdown

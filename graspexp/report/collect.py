@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from graspexp.record import CorruptLogError, read_result
+from graspexp.record import TRIALS_DIR, CorruptLogError, read_result
 from graspexp.record.writer import PARTIAL_SUFFIX
 
 SETTING_KEYS: tuple[str, ...] = ("dataset", "planner", "mode", "rot")
@@ -39,7 +39,7 @@ def find_trial_logs(root: Path | str) -> list[Path]:
     found = set()
     for pattern in ("*.mcap", f"*.mcap{PARTIAL_SUFFIX}"):
         found.update(
-            p for p in root.rglob(pattern) if p.is_file() and "trials" in p.relative_to(root).parts[:-1]
+            p for p in root.rglob(pattern) if p.is_file() and TRIALS_DIR in p.relative_to(root).parts[:-1]
         )
     return sorted(found)
 

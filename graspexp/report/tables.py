@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from graspexp.outcome import FailureReason
 from graspexp.report.paper import (
     BASELINES,
     PAPER_TABLES,
@@ -19,7 +20,6 @@ from graspexp.report.paper import (
     PaperTable,
 )
 from graspexp.report.stats import percentiles, wilson_interval
-from graspexp.sim.outcome import FailureReason
 
 AVERAGE = "Average"
 AVERAGE_SAME = "Paper avg., same objects"

@@ -12,12 +12,16 @@ is exact for a closed mesh wherever the closest point lies inside a face, and at
 vertex every adjacent face gives the same sign.
 """
 
+from __future__ import annotations
+
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import trimesh
 
-from graspexp.sim.collision_shapes import CollisionShape
+if TYPE_CHECKING:  # collision_shapes imports this module to check the shapes it makes
+    from graspexp.sim.collision_shapes import CollisionShape
 
 _ON_HULL_M = 1e-5
 """Tolerance for a sample to lie on another hull's boundary, m."""

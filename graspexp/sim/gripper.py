@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import sapien
 
-from graspexp.config.gripper import GripperConfig, finger_z_range_m
+from graspexp.config.gripper import GripperConfig, GripperGeometry
 from graspexp.geometry import matrix_to_quat_wxyz
 from graspexp.sim.scene import GRIPPER_BIT, OBJECT_BIT, SUPPORT_BIT, set_groups
 
@@ -114,12 +114,9 @@ def build_gripper(
         link.set_mass_and_inertia(0.1, sapien.Pose(), [1e-4] * 3)
     palm = link
     palm.set_name(PALM_NAME)
-    L = float(cfg.finger_length_m)
-    root_z, _ = finger_z_range_m(cfg)  # the palm face, where the fingers start
-    px, py, pz = cfg.palm_size_m
-    palm.add_box_collision(
-        sapien.Pose([0.0, 0.0, root_z - pz / 2]), half_size=[px / 2, py / 2, pz / 2], material=pad
-    )
+    geometry = GripperGeometry.of(cfg)
+    box = geometry.palm()
+    palm.add_box_collision(sapien.Pose(list(box.center)), half_size=[s / 2 for s in box.size], material=pad)
     for name, axis, sign in (("finger_left", "y", 1.0), ("finger_right", "-y", -1.0)):
         f = ab.create_link_builder(palm)
         f.set_name(name)
@@ -128,13 +125,10 @@ def build_gripper(
         f.set_joint_properties(
             "prismatic", [[-CLOSE_PAST_M, cfg.max_width_m / 2]], sapien.Pose(q=q), sapien.Pose(q=q)
         )
-        t = float(cfg.finger_thickness_m)
-        center = [0.0, sign * t / 2, root_z + L / 2]
+        box = geometry.finger(sign)
+        center = list(box.center)
         f.add_box_collision(
-            sapien.Pose(center),
-            half_size=[cfg.finger_width_m / 2, t / 2, L / 2],
-            material=pad,
-            density=1000.0,
+            sapien.Pose(center), half_size=[s / 2 for s in box.size], material=pad, density=1000.0
         )
         f.set_mass_and_inertia(cfg.finger_mass_kg, sapien.Pose(center), [1e-5] * 3)
     art = ab.build(fix_root_link=True)

@@ -5,6 +5,8 @@ from omegaconf import OmegaConf
 
 from graspexp.config.registry import job_config_from_yaml
 from graspexp.datasets import load_object
+from graspexp.planning import plan
+from graspexp.quality import fc_min_mu
 from graspexp.seeding import derive_seed
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import NullRecorder, TrialContext, run_trial
@@ -39,7 +41,16 @@ def resimulate(log) -> tuple[bool, str]:
     model = load_object(cfg.dataset, name, cfg.planner.n_points, derive_seed(cfg.seed, "cloud", name))
     capture = _PoseCapture()
     result = run_trial(
-        TrialContext(plain, model, collision_shape(model.mesh, plain.sim), trial, seed, capture)
+        TrialContext(
+            plain,
+            model,
+            collision_shape(model.mesh, plain.sim),
+            trial,
+            seed,
+            capture,
+            plan=plan,
+            quality=fc_min_mu,
+        )
     )
     logged = log.result or {}
     problems = []

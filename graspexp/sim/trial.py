@@ -1,28 +1,31 @@
 """The trial protocol (paper IV-A, IV-C, IV-D): drop, settle, plan, approach, close, then
 remove the box and hold (collab) or pull back and lift (bin). Staged checks stop at the first failure.
+
+The trial knows nothing of how a grasp is planned or scored: the caller passes the planner and the quality
+check (:class:`TrialContext` ``plan`` and ``quality``), and the log it writes to (:class:`TrialLog`).
 """
 
 import dataclasses
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from typing import Any, Protocol
 
 import numpy as np
 import sapien
+import trimesh
 from omegaconf import DictConfig, OmegaConf
 
 from graspexp.config import JobConfig
 from graspexp.datasets.model import ObjectModel
 from graspexp.geometry import axis_angle_matrix, make_pose, random_rotation, transform_points, yaw_rotation
+from graspexp.outcome import FailureReason, TrialResult
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
-from graspexp.planning.registry import plan
-from graspexp.planning.request import PlanRequest
-from graspexp.quality import grasp_quality
+from graspexp.planning.request import PlanRequest, PlanResult
 from graspexp.seeding import derive_seed, rng_for
 from graspexp.sim.contacts import SupportTouch, contact_records, finger_forces
 from graspexp.sim.gripper import FINGER_NAMES, Gripper, build_gripper
-from graspexp.sim.outcome import FailureReason, TrialResult
 from graspexp.sim.scene import SUPPORT_NAME, TrialScene, build_scene
 
 FELL_BELOW_M = 0.05
@@ -39,14 +42,56 @@ class TrialFailed(Exception):
         self.reason = reason
 
 
+class TrialLog(Protocol):
+    """What a trial writes to its log (:class:`graspexp.record.TrialWriter` is one); times ``t_s`` are sim
+    time, s. ``active`` False: the trial skips gathering the per-step messages (transforms, contacts)."""
+
+    active: bool
+
+    def scene(self, t_s: float, entities: Sequence[Any]) -> None: ...
+    def delete_entities(self, t_s: float, ids: Sequence[str]) -> None: ...
+    def transforms(
+        self, t_s: float, frames: Mapping[str, tuple[Sequence[float], Sequence[float]]]
+    ) -> None: ...
+    def contacts(self, t_s: float, contacts: Sequence[Mapping[str, Any]]) -> None: ...
+    def grasp(self, t_s: float, grasp: Mapping[str, Any]) -> None: ...
+    def phase(self, t_s: float, name: str, info: Mapping[str, Any] | None = None) -> None: ...
+    def result(self, t_s: float, result: Mapping[str, Any]) -> None: ...
+
+
 class NullRecorder:
-    """Stands in for a :class:`graspexp.record.TrialRecorder` when logging is off: every method is a no-op.
-    Subclasses that keep some messages set ``active = True``, so the trial gathers them."""
+    """The :class:`TrialLog` of a trial that is not logged: every message is dropped. Subclasses that keep
+    some messages set ``active = True``, so the trial gathers them."""
 
     active = False
 
-    def __getattr__(self, name):
-        return lambda *args, **kwargs: None
+    def scene(self, t_s: float, entities: Sequence[Any]) -> None:
+        pass
+
+    def delete_entities(self, t_s: float, ids: Sequence[str]) -> None:
+        pass
+
+    def transforms(self, t_s: float, frames: Mapping[str, tuple[Sequence[float], Sequence[float]]]) -> None:
+        pass
+
+    def contacts(self, t_s: float, contacts: Sequence[Mapping[str, Any]]) -> None:
+        pass
+
+    def grasp(self, t_s: float, grasp: Mapping[str, Any]) -> None:
+        pass
+
+    def phase(self, t_s: float, name: str, info: Mapping[str, Any] | None = None) -> None:
+        pass
+
+    def result(self, t_s: float, result: Mapping[str, Any]) -> None:
+        pass
+
+
+PlanFn = Callable[[PlanRequest], PlanResult]
+"""A planner: the grasp for a request (raises :class:`NoFeasibleGrasp` when there is none)."""
+QualityFn = Callable[[trimesh.Trimesh, Grasp], float]
+"""Physics-free quality of a grasp on a mesh in the same frame: the smallest force-closure friction
+coefficient (inf or NaN when none)."""
 
 
 @dataclass
@@ -59,10 +104,14 @@ class TrialContext:
     hulls: list[np.ndarray]
     trial: int
     trial_seed: int
-    recorder: object = field(default_factory=NullRecorder)
+    recorder: TrialLog = field(default_factory=NullRecorder)
     scene: object | None = None
     """The object's Foxglove scene for the log (:func:`graspexp.record.object_scene`, built once per object);
     None: no /scene messages."""
+    plan: PlanFn = field(kw_only=True)
+    """Plans the grasp (the runner passes :func:`graspexp.planning.plan`)."""
+    quality: QualityFn = field(kw_only=True)
+    """Scores the planned grasp without physics (the runner passes :func:`graspexp.quality.fc_min_mu`)."""
 
 
 def plain_config(cfg: DictConfig) -> JobConfig:
@@ -109,7 +158,7 @@ class _Sim:
     two dot products) and, while :meth:`watch_support` is on, the gripper-support contact check.
     """
 
-    def __init__(self, ts: TrialScene, cfg: JobConfig, recorder, timings: dict[str, float]):
+    def __init__(self, ts: TrialScene, cfg: JobConfig, recorder: TrialLog, timings: dict[str, float]):
         self.ts, self.cfg, self.rec, self.timings = ts, cfg, recorder, timings
         self.dt = float(cfg.sim.timestep_s)
         self.t, self.steps = 0.0, 0
@@ -119,7 +168,7 @@ class _Sim:
         self.touch: SupportTouch | None = None
         self.touched_support = False
         self.max_speed_sq = float(cfg.sim.max_speed_mps) ** 2
-        self.recording = getattr(recorder, "active", True)
+        self.recording = recorder.active
         self._next_log = self.log_every if self.recording else -1
         self._physx_step = ts.scene.physx_system.step
         self._contacts = ts.scene.physx_system.get_contacts
@@ -313,7 +362,7 @@ def _plan(ctx: TrialContext, sim: _Sim) -> Grasp:
         seed=derive_seed(ctx.trial_seed, "plan"),
     )
     try:
-        grasp = plan(req).grasp
+        grasp = ctx.plan(req).grasp
     except NoFeasibleGrasp as e:
         raise TrialFailed(FailureReason.NO_FEASIBLE_GRASP, str(e)) from None
     sim.phase("plan")
@@ -326,7 +375,7 @@ def _force_closure_mu(ctx: TrialContext, sim: _Sim, grasp: Grasp) -> float:
     object frame, so the mesh's ray-cast index is built once per object, not per trial); logged on /grasp."""
     T = sim.ts.object_pose()
     in_object = dataclasses.replace(grasp, pose=np.linalg.inv(T) @ grasp.pose)
-    mu = grasp_quality(ctx.model.mesh, in_object)["fc_min_mu"]
+    mu = ctx.quality(ctx.model.mesh, in_object)
     mu = mu if np.isfinite(mu) else float("nan")
     ctx.recorder.phase(sim.t, "quality", {"fc_min_mu": mu})
     return mu

@@ -1,0 +1,67 @@
+"""Check that two sweeps gave the same trials: ``python -m graspexp.bench.compare_runs BEFORE AFTER``.
+
+Every ``results.csv`` under BEFORE is matched with the file at the same relative path under AFTER, and
+every row (keyed by object and trial) is compared cell by cell as text, so a float that changed in its last
+digit counts. Wall-clock timing columns (``timings_s*``) are ignored. Exit status 0 when every row is
+identical, 1 otherwise (the differing cells are printed).
+"""
+
+import argparse
+import csv
+import sys
+from pathlib import Path
+
+IGNORED_PREFIXES = ("timings_s",)
+"""Columns that measure wall time: they differ between runs of the same config."""
+
+
+def _rows(path: Path) -> dict[tuple[str, str], dict[str, str]]:
+    """The rows of one results.csv keyed by (object, trial), timing columns dropped."""
+    with path.open(newline="") as f:
+        return {
+            (row["object"], row["trial"]): {
+                k: v for k, v in row.items() if not k.startswith(IGNORED_PREFIXES)
+            }
+            for row in csv.DictReader(f)
+        }
+
+
+def compare(before: Path, after: Path) -> list[str]:
+    """Differences between the sweeps under ``before`` and ``after``, one line each; [] when identical."""
+    problems = []
+    tables = sorted(p.relative_to(before) for p in before.rglob("results.csv"))
+    if not tables:
+        return [f"no results.csv under {before}"]
+    for rel in tables:
+        if not (after / rel).is_file():
+            problems.append(f"{rel}: missing under {after}")
+            continue
+        a, b = _rows(before / rel), _rows(after / rel)
+        for key in sorted(a.keys() | b.keys()):
+            if key not in a or key not in b:
+                problems.append(f"{rel} {key}: only under {before if key in a else after}")
+                continue
+            for col in sorted(a[key].keys() | b[key].keys()):
+                if a[key].get(col) != b[key].get(col):
+                    problems.append(f"{rel} {key} {col}: {a[key].get(col)!r} != {b[key].get(col)!r}")
+    return problems
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m graspexp.bench.compare_runs", description=__doc__)
+    parser.add_argument("before", type=Path, help="sweep directory of the reference run")
+    parser.add_argument("after", type=Path, help="sweep directory of the run to check")
+    args = parser.parse_args(argv)
+    problems = compare(args.before, args.after)
+    n_tables = len(list(args.before.rglob("results.csv")))
+    n_rows = sum(len(_rows(p)) for p in args.before.rglob("results.csv"))
+    for line in problems:
+        print(line)
+    print(
+        f"{n_tables} results.csv, {n_rows} trials: {'identical' if not problems else f'{len(problems)} differences'}"
+    )
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,46 @@
+"""The channels of a trial log: every topic of :mod:`graspexp.record.schemas` on one ``foxglove.Context``."""
+
+import functools
+
+import foxglove
+from foxglove.channels import (
+    FrameTransformsChannel,
+    PointCloudChannel,
+    PoseInFrameChannel,
+    SceneUpdateChannel,
+)
+
+from graspexp.record import schemas as S
+
+
+@functools.cache
+def body_names() -> tuple[str, ...]:
+    """The physics bodies that can touch, in /contacts index order (imported here, not at module level, so
+    that reading logs does not load the simulator)."""
+    from graspexp.sim.gripper import FINGER_NAMES, PALM_NAME
+    from graspexp.sim.scene import GROUND_NAME, OBJECT_NAME, SUPPORT_NAME
+
+    return (OBJECT_NAME, SUPPORT_NAME, GROUND_NAME, PALM_NAME, *FINGER_NAMES)
+
+
+class Channels:
+    """Every channel of a trial log on one ``foxglove.Context`` (its sinks: an MCAP file, a live server)."""
+
+    def __init__(self, context: foxglove.Context):
+        self.context = context
+        self.tf = FrameTransformsChannel(S.TOPIC_TF, context=context)
+        self.contacts = PointCloudChannel(
+            S.TOPIC_CONTACTS, metadata={"bodies": ",".join(body_names())}, context=context
+        )
+        self.scene = SceneUpdateChannel(S.TOPIC_SCENE, context=context)
+        self.grasp_pose = PoseInFrameChannel(S.TOPIC_GRASP_POSE, context=context)
+        self.json = {
+            topic: foxglove.Channel(
+                topic,
+                schema=foxglove.Schema(name=name, encoding=S.SCHEMA_ENCODING, data=S.schema_bytes(name)),
+                message_encoding=S.MESSAGE_ENCODING,
+                context=context,
+            )
+            for topic, name in S.TOPIC_SCHEMAS.items()
+            if name in S.SCHEMAS
+        }
