@@ -111,6 +111,7 @@ def _averages_markdown(avg: pd.DataFrame, dataset: str) -> str:
                 _cell(*mine.loc[s, ["ours_pct", "lo_pct", "hi_pct"]]) if s in mine.index else "n/a"
             )
         row["mean of settings"] = fmt_pct(mine["ours_pct"].mean())
+        row["trials"] = str(int(mine["n"].sum()))  # fewer than the others: a reading still running
         rows.append(row)
     return markdown(pd.DataFrame(rows).fillna(""), index=False)
 
