@@ -10,11 +10,9 @@ import pytest
 from test_planner_common import RG2
 
 import graspexp.planning.optimal as optimal
-from graspexp.cli import compose_config
 from graspexp.config import CostConfig, DatasetConfig, OptimalConfig
 from graspexp.config.gripper import GripperGeometry
-from graspexp.datasets import dataset_objects, load_object
-from graspexp.datasets.catalog import candidate_paths
+from graspexp.datasets import available_objects, load_object
 from graspexp.plan import upright_pose
 from graspexp.planning import PlanRequest, plan
 from graspexp.planning.clusters import KMEANS_MAX_ITER, KMEANS_TOL, Clusters, max_radii_m, segment
@@ -175,10 +173,9 @@ def test_kernel_cache_goes_to_the_graspexp_cache_and_survives_an_unwritable_one(
 
 
 def _objects(dataset: str, root) -> tuple[DatasetConfig, list[str]]:
-    """The config's object list (paper Table 1 / Table 2) restricted to meshes present under ``root``."""
+    """The dataset's default objects (paper Table 1 / Table 2) whose meshes are present under ``root``."""
     cfg = DatasetConfig(name=dataset, root=str(root), regions=f"{dataset}.yaml")
-    names = dataset_objects(compose_config([f"dataset={dataset}"]).dataset)
-    return cfg, [n for n in names if any(p.is_file() for p in candidate_paths(cfg, n))]
+    return cfg, available_objects(cfg)
 
 
 @pytest.mark.parametrize("dataset", ["ycb", "linemod"])
