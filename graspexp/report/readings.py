@@ -11,7 +11,7 @@ import pandas as pd
 
 from graspexp.report.collect import collect
 from graspexp.report.paper import PAPER_TABLES, SETTINGS
-from graspexp.report.render import SHORT, fmt_paper, fmt_pct, markdown
+from graspexp.report.render import SHORT, fmt_ci, fmt_paper, fmt_pct, markdown
 from graspexp.report.tables import AVERAGE, AVERAGE_SAME, success_table
 
 CEILING_KEYS = ("dataset", "object", "mode", "rot")
@@ -34,10 +34,6 @@ def _results(name: str, root: Path) -> pd.DataFrame:
             f"reading {name!r}: {root} holds planners {sorted(df['planner'].unique())}: one directory per reading"
         )
     return df
-
-
-def _cell(pct: float, lo: float, hi: float) -> str:
-    return f"{fmt_pct(pct)} [{fmt_pct(lo)}, {fmt_pct(hi)}]"
 
 
 def readings_frame(entries: dict[str, tuple[Path, str]]) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -108,7 +104,7 @@ def _averages_markdown(avg: pd.DataFrame, dataset: str) -> str:
         row = {"reading": head["reading"], "what": head["what"]}
         for s in settings:
             row[SHORT[s]] = (
-                _cell(*mine.loc[s, ["ours_pct", "lo_pct", "hi_pct"]]) if s in mine.index else "n/a"
+                fmt_ci(*mine.loc[s, ["ours_pct", "lo_pct", "hi_pct"]]) if s in mine.index else "n/a"
             )
         row["mean of settings"] = fmt_pct(mine["ours_pct"].mean())
         row["trials"] = str(int(mine["n"].sum()))  # fewer than the others: a reading still running

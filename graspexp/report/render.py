@@ -46,10 +46,15 @@ def fmt_paper(v: float) -> str:
     return f"{v:.0f}" if float(v).is_integer() else f"{v:.2f}"
 
 
+def fmt_ci(pct: float, lo: float, hi: float) -> str:
+    """A success rate with its interval, all in %: ``90 [59.6, 98.2]``."""
+    return f"{fmt_pct(pct)} [{fmt_pct(lo)}, {fmt_pct(hi)}]"
+
+
 def _ours(row: pd.Series) -> str:
     if not row["n"]:
         return NA
-    text = f"{fmt_pct(row['ours_pct'])} [{fmt_pct(row['lo_pct'])}, {fmt_pct(row['hi_pct'])}]"
+    text = fmt_ci(row["ours_pct"], row["lo_pct"], row["hi_pct"])
     if row["label"] in (AVERAGE, AVERAGE_SAME):
         return text
     if row["n"] != TRIALS_PER_SETTING:
