@@ -194,7 +194,7 @@ def _pads_hold(
     """Step 3 of the module doc for (B, 4, 4) poses: (B,) whether both pads' contacts are at least
     ``min_pad_depth_m`` deep and inside the friction cone of ``friction_coef``, and (B,) the depth, m."""
     rots = poses[:, :3, :3]
-    local_normals = np.einsum("ni,bij->bnj", normals, rots)
+    local_normals = normals[None] @ rots
     depth, angle = pad_contacts(local_coords(points, poses), local_normals, geometry, pl.contact_band_m)
     return (depth >= pl.min_pad_depth_m) & (angle <= np.arctan(pl.friction_coef)), depth
 
