@@ -268,14 +268,15 @@ def max_lift_m(gripper: GripperConfig) -> float:
 
 def place_for_request(req, poses: np.ndarray, min_widths_m: np.ndarray | float = 0.0) -> Placement:
     """:func:`place_grasps` with the request's cloud, support plane, gripper and planner settings
-    (sweep = ``planner.sphere_radius_m``, ``collision_margin_m``, ``width_clearance_m``)."""
+    (sweep = ``planner.sphere_radius_m``, ``collision_margin_m``, ``width_clearance_m``). A support that
+    does not block the gripper (``req.support_blocks_gripper`` False) is not checked."""
     pl, gr = req.planner, req.gripper
     return place_grasps(
         np.asarray(req.points, dtype=np.float64),
         poses,
         gr,
         sweep_m=pl.sphere_radius_m,
-        table_z=req.table_z,
+        table_z=req.table_z if req.support_blocks_gripper else -np.inf,
         margin_m=pl.collision_margin_m,
         clearance_m=pl.width_clearance_m,
         max_lift_m=max_lift_m(gr),

@@ -13,12 +13,13 @@ is tried at several depths along its approach, and every try is checked as follo
 2. **Swept-volume collision** of both fingers and the palm with the cloud and the support along the whole
    straight approach (:func:`graspexp.planning.collision.place_grasps`, margin ``collision_margin_m``).
 3. **Pad contacts** (``depth_offsets_m``, ``rolls_deg``, ``min_pad_depth_m``, ``pad_depth_target_m``,
-   ``friction_coef``): the grasp frame is rolled about the approach by each of ``rolls_deg`` and its
+   ``friction_coef``, ``min_contacts_in_area``): the grasp frame is rolled about the approach by each of ``rolls_deg`` and its
    point moved along the approach by each offset; a try is kept only when both pads' contacts are
-   centred at least ``min_pad_depth_m`` behind the fingertips and their surface normals lie inside the
-   friction cone about the closing axis (:func:`graspexp.planning.stability.pad_contacts`). Per path the
-   first roll with a passing try is taken, and in it the try whose shallower pad depth comes closest
-   to ``pad_depth_target_m`` (the smallest offset on a tie).
+   centred at least ``min_pad_depth_m`` behind the fingertips, their surface normals lie inside the
+   friction cone about the closing axis and at least ``min_contacts_in_area`` of each pad's contact
+   points are grasping-area points (:func:`graspexp.planning.stability.pad_contacts`). Per path the
+   first roll with a passing try is taken, and in it the try whose shallower pad depth reaches
+   ``pad_depth_target_m`` with the smallest move (else the deepest).
 4. **Gravity arm** (``com_weight``): the path's cost is multiplied by ``1 + com_weight * a / D``, with
    ``a`` the arm of gravity about the closing axis (:func:`graspexp.planning.stability.gravity_arm_m`;
    centre of mass = the cloud's solid-hull centroid) and ``D`` the diagonal of the cloud's box.
@@ -107,14 +108,14 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
         held = np.zeros(len(placed.ok), dtype=bool)
         if placed.ok.any():
             held[placed.ok], depth[placed.ok] = _pads_hold(
-                pl, geometry, points, normals, placed.poses[placed.ok]
+                pl, geometry, points, normals, cand.area_mask, placed.poses[placed.ok]
             )
         ok = placed.ok & held
         for key, n in placed.counts().items():
             rejected[key] += n
         rejected["n_weak_contact"] += int((placed.ok & ~ok).sum())
         ok, depth = ok.reshape(b, n_roll, n_off), depth.reshape(b, n_roll, n_off)
-        # per path: the first roll with a passing try, then the depth closest to the target
+        # per path: the first roll with a passing try, then the target depth with the smallest move
         for i in np.flatnonzero(ok.any(axis=(1, 2))):
             r = int(np.argmax(ok[i].any(axis=1)))
             score = np.where(ok[i, r], np.minimum(depth[i, r], pl.pad_depth_target_m), -np.inf)
@@ -138,7 +139,7 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
             f"optimal_plus: all {examined} paths above the support failed at every depth: "
             f"{rejected['n_too_wide']} tries too wide for the stroke {gr.max_width_m} m, "
             f"{rejected['n_below_support']} below the support, {rejected['n_collides']} colliding with the "
-            f"cloud, {rejected['n_weak_contact']} with a pad contact shallower than {pl.min_pad_depth_m} m or outside the friction cone"
+            f"cloud, {rejected['n_weak_contact']} with a pad contact shallower than {pl.min_pad_depth_m} m, outside the friction cone or outside the grasping area"
         )
     passed = passed[: pl.shortlist]
     poses = np.stack([p[2] for p in passed])
@@ -189,14 +190,22 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
 
 
 def _pads_hold(
-    pl, geometry: GripperGeometry, points: np.ndarray, normals: np.ndarray, poses: np.ndarray
+    pl,
+    geometry: GripperGeometry,
+    points: np.ndarray,
+    normals: np.ndarray,
+    area_mask: np.ndarray,
+    poses: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Step 3 of the module doc for (B, 4, 4) poses: (B,) whether both pads' contacts are at least
-    ``min_pad_depth_m`` deep and inside the friction cone of ``friction_coef``, and (B,) the depth, m."""
-    rots = poses[:, :3, :3]
-    local_normals = normals[None] @ rots
-    depth, angle = pad_contacts(local_coords(points, poses), local_normals, geometry, pl.contact_band_m)
-    return (depth >= pl.min_pad_depth_m) & (angle <= np.arctan(pl.friction_coef)), depth
+    ``min_pad_depth_m`` deep, inside the friction cone of ``friction_coef`` and at least
+    ``min_contacts_in_area`` in the grasping area, and (B,) the depth, m."""
+    local_normals = normals[None] @ poses[:, :3, :3]
+    depth, angle, share = pad_contacts(
+        local_coords(points, poses), local_normals, geometry, pl.contact_band_m, area_mask
+    )
+    ok = (depth >= pl.min_pad_depth_m) & (angle <= np.arctan(pl.friction_coef))
+    return ok & (share >= pl.min_contacts_in_area), depth
 
 
 def _roll(angle_rad: float) -> np.ndarray:
@@ -224,5 +233,5 @@ def _noise_pass(
     for motion in motions:
         moved = points @ motion[:3, :3].T + motion[:3, 3]
         free = cloud_hits(moved, poses, req.gripper, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0) == 0
-        ok += free & _pads_hold(pl, geometry, moved, normals @ motion[:3, :3].T, poses)[0]
+        ok += free & _pads_hold(pl, geometry, moved, normals @ motion[:3, :3].T, req.area_mask, poses)[0]
     return ok / len(motions)

@@ -9,7 +9,8 @@ axis, origin midway between the pads; the fingers span ``[root_z_m, tip_z_m]`` a
   the contact is centred. Its angle is the one between the mean outward normal there and the closing
   axis: a pad pressing on a surface tilted beyond the friction cone (``atan(mu)``) pushes the object
   along the approach. A grasp held by the fingertip edges (depth near 0) or on slopes is squeezed out
-  when the pads press.
+  when the pads press. A side's share in the area is the fraction of its contact points that are
+  grasping-area points: where the pads will touch, whatever the grasp point was aimed at.
 - **Gravity arm.** Once the support is gone, gravity pulls at the centre of mass; its torque about the
   closing axis (the line through the grasp point along +Y) is resisted only by the pads' torsional
   friction. Its arm is ``|Y . ((g - o) x z_world)|``.
@@ -54,19 +55,24 @@ def gravity_arm_m(poses: np.ndarray, com_m: np.ndarray) -> np.ndarray:
 
 
 def pad_contacts(
-    local: np.ndarray, local_normals: np.ndarray, geometry: GripperGeometry, band_m: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Depth of the shallower side's contact from the fingertips, m, and the larger of the two sides'
-    angles between the contact normal and the closing axis, rad (module doc), per grasp.
+    local: np.ndarray,
+    local_normals: np.ndarray,
+    geometry: GripperGeometry,
+    band_m: float,
+    area_mask: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Depth of the shallower side's contact from the fingertips, m, the larger of the two sides' angles
+    between the contact normal and the closing axis, rad (module doc), and the smaller of the two sides'
+    shares of contact points in the grasping area, per grasp.
 
     local : (B, N, 3) cloud points in each grasp frame; local_normals : (B, N, 3) their outward unit
-    normals in the same frames. A side's normal is the mean of its contact points' normals; the left pad
-    (+Y side) presses against a surface facing +Y. Where a side has no contact point: depth -inf and
-    angle pi.
+    normals in the same frames; area_mask : (N,) bool grasping area (None: all points). A side's normal
+    is the mean of its contact points' normals; the left pad (+Y side) presses against a surface facing
+    +Y. Where a side has no contact point: depth -inf, angle pi and share 0.
 
     Returns
     -------
-    depth_m, angle_rad : (B,) float64.
+    depth_m, angle_rad, in_area : (B,) float64.
     """
     x, y, z = local[..., 0], local[..., 1], local[..., 2]
     reach = (np.abs(x) <= geometry.finger_width_m / 2) & (z >= geometry.root_z_m) & (z <= geometry.tip_z_m)
@@ -74,6 +80,8 @@ def pad_contacts(
     lo = np.where(reach, y, np.inf).min(axis=1, keepdims=True)
     depth = np.full(len(local), np.inf)
     angle = np.zeros(len(local))
+    share = np.ones(len(local))
+    inside = np.ones(local.shape[1], dtype=bool) if area_mask is None else np.asarray(area_mask, dtype=bool)
     for sign, side in ((1.0, reach & (y >= hi - band_m)), (-1.0, reach & (y <= lo + band_m))):
         n = side.sum(axis=1)
         some = n > 0
@@ -85,7 +93,8 @@ def pad_contacts(
         with np.errstate(invalid="ignore", divide="ignore"):
             cos = np.clip(sign * normal[:, 1] / length, -1.0, 1.0)
         angle = np.maximum(angle, np.where(some & (length > 0), np.arccos(cos), np.pi))
-    return depth, angle
+        share = np.minimum(share, np.where(some, (side & inside).sum(axis=1) / np.maximum(n, 1), 0.0))
+    return depth, angle, share
 
 
 def pose_perturbations(

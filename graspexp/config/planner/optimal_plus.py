@@ -33,10 +33,12 @@ class OptimalPlusConfig(PaperPathsConfig, OpeningConfig):
     reaching the object). From 2 cm back (the fingertips off a support just below c_k) to half the RG2
     finger length in (the paper's c_k is a mean of surface points: on a face seen from above it lies on
     the surface, 1 cm from the fingertips)."""
-    min_pad_depth_m: float = 0.01
-    """Smallest distance from the fingertips to the centre of either pad's contact, m. 0.01 = the
-    gripper's own TCP depth (``gripper.tcp_from_tip_m``): shallower grasps hold by the fingertip edges,
-    which the pads' pressure squeezes out along the approach."""
+    min_pad_depth_m: float = 0.005
+    """Smallest distance from the fingertips to the centre of either pad's contact, m: a contact centred
+    closer lies on the pad's edge (``contact_band_m`` 4 mm of contact, 1 mm to spare), which the pads'
+    pressure squeezes out along the approach. (0.01, the TCP's depth ``gripper.tcp_from_tip_m``, was the
+    first value: it also rejects face contacts on tapered objects, e.g. every in-area grasp of the iron,
+    whose body is widest at the soleplate; the README's optimal_plus table shows both.)"""
     pad_depth_target_m: float = 0.025
     """Pad depth aimed at when several depths pass, m: about a third of the RG2 finger (80 mm), deep
     enough to hold by the pad's face and short of the palm."""
@@ -44,6 +46,10 @@ class OptimalPlusConfig(PaperPathsConfig, OpeningConfig):
     """Coulomb friction the contact test assumes: each pad's contact normal must lie within atan(mu)
     (26.6 deg at 0.5) of the closing axis. 0.5 is the antipodal baseline's value and half the pads'
     simulated friction (``gripper.pad_friction`` 1.0, averaged by PhysX with the object's)."""
+    min_contacts_in_area: float = 1.0
+    """Share of each pad's contact points that must be grasping-area points (III-A: the robot grasps
+    the area, not the part a person holds). The grasp point is aimed inside the area, but fingers 8 cm
+    long can close on another part first (the iron's handle above its body)."""
     contact_band_m: float = 0.004
     """Points within this of a side's extreme y count as that pad's contacts, m: about the cloud's point
     spacing (2048 points on a Table 1 object)."""
@@ -75,6 +81,7 @@ CONSTRAINTS = {
     "min_pad_depth_m": [Interval(-0.5, 0.5, unit="m")],
     "pad_depth_target_m": [Interval(0, 0.5, unit="m")],
     "friction_coef": [Interval(0, 10, "right")],
+    "min_contacts_in_area": [Interval(0, 1)],
     "contact_band_m": [Interval(0, 0.05, "right", "m")],
     "com_weight": [Interval(0, 100)],
     "shortlist": [Interval(1, 100_000, integer=True)],
