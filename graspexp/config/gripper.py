@@ -79,12 +79,6 @@ class GripperGeometry:
             g.tcp_from_tip_m,
         )
 
-    def pad_slab(self, margin_m: float = 0.0) -> tuple[float, float, float]:
-        """``(half_width, z_lo, z_hi)``, m: a point of the gripper frame lies between the pads (in their
-        sweep along Y) when ``|x| <= half_width`` and ``z_lo <= z <= z_hi``; the finger width and span
-        grown by ``margin_m`` on every side."""
-        return self.finger_width_m / 2 + margin_m, self.root_z_m - margin_m, self.tip_z_m + margin_m
-
     def palm(self) -> Box:
         """The palm box in the gripper frame."""
         px, py, pz = self.palm_size_m

@@ -27,7 +27,6 @@ import numpy as np
 
 from graspexp.config import GripperConfig
 from graspexp.config.gripper import GripperGeometry
-from graspexp.planning.pose import closing_section
 
 POSE_BATCH = 128
 """Poses per vectorised block in :func:`cloud_hits` (bounds memory at ~POSE_BATCH x N x 3 floats)."""
@@ -62,6 +61,28 @@ def local_coords(points_m: np.ndarray, poses: np.ndarray) -> np.ndarray:
     poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)
     rel = p[None, :, :] - poses[:, None, :3, 3]
     return np.einsum("bni,bij->bnj", rel, poses[:, :3, :3])
+
+
+def closing_section(
+    local: np.ndarray, gripper: GripperConfig, margin_m: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Range of ``y`` over the points in the pads' reach: what the fingers must close around.
+
+    local : (B, N, 3) points in each grasp frame. A point is in reach when ``|x| <= fw/2 + margin`` and
+    ``z`` lies within the finger span (module doc) grown by ``margin``.
+
+    Returns
+    -------
+    lo, hi : (B,) float64, metres; both 0 where no point is in reach.
+    """
+    geometry = GripperGeometry.of(gripper)
+    fw, root, tip = geometry.finger_width_m, geometry.root_z_m, geometry.tip_z_m
+    x, y, z = local[..., 0], local[..., 1], local[..., 2]
+    reach = (np.abs(x) <= fw / 2 + margin_m) & (z >= root - margin_m) & (z <= tip + margin_m)
+    hi = np.where(reach, y, -np.inf).max(axis=1)
+    lo = np.where(reach, y, np.inf).min(axis=1)
+    some = reach.any(axis=1)
+    return np.where(some, lo, 0.0), np.where(some, hi, 0.0)
 
 
 def cloud_hits(

@@ -12,10 +12,8 @@ Width
 
 Section between the pads
     In the grasp frame, take the object points inside the pads' sweep: ``|x| <= finger_width/2`` and
-    ``z`` within the fingers' extent (:meth:`graspexp.config.gripper.GripperGeometry.pad_slab`). Their span
-    ``[y_lo, y_hi]`` along the closing axis is the section the fingers close on (:func:`slab_spans_m`,
-    compiled, for the planner's paths; :func:`closing_section`, numpy, for batches of posed candidates, with
-    a margin); its extent
+    ``z`` within the fingers' extent (:class:`graspexp.config.gripper.GripperGeometry`). Their span ``[y_lo, y_hi]`` along the
+    closing axis is the section the fingers close on (:func:`slab_spans_m`); its extent
     ``y_hi - y_lo`` is the opening it needs. The pads close symmetrically, so the planner moves the
     grasp point along Y to the section's middle, ``c_k + (y_lo + y_hi)/2 * Y`` (the paper's c_k is a
     mean of surface points and can sit off the section's middle, e.g. half a ring for K = 2); X, Y, Z
@@ -80,26 +78,12 @@ def slab_spans_m(
     """
     rots = np.ascontiguousarray(rotations, dtype=np.float64)
     centers = np.ascontiguousarray(np.broadcast_to(np.asarray(centers_m, dtype=np.float64), (len(rots), 3)))
-    half_width, z_lo, z_hi = GripperGeometry.of(gripper).pad_slab()
-    return slab_spans(np.ascontiguousarray(points_m, dtype=np.float64), centers, rots, half_width, z_lo, z_hi)
-
-
-def closing_section(
-    local: np.ndarray, gripper: GripperConfig, margin_m: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """The section between the pads (module doc) of points already in each grasp frame, the slab grown by
-    ``margin_m`` (:meth:`GripperGeometry.pad_slab`); numpy, for batches of candidate poses.
-
-    local : (B, N, 3) points in each grasp frame, m.
-
-    Returns
-    -------
-    lo, hi : (B,) float64, metres; both 0 where no point is in reach.
-    """
-    half_width, z_lo, z_hi = GripperGeometry.of(gripper).pad_slab(margin_m)
-    x, y, z = local[..., 0], local[..., 1], local[..., 2]
-    reach = (np.abs(x) <= half_width) & (z >= z_lo) & (z <= z_hi)
-    hi = np.where(reach, y, -np.inf).max(axis=1)
-    lo = np.where(reach, y, np.inf).min(axis=1)
-    some = reach.any(axis=1)
-    return np.where(some, lo, 0.0), np.where(some, hi, 0.0)
+    geometry = GripperGeometry.of(gripper)
+    return slab_spans(
+        np.ascontiguousarray(points_m, dtype=np.float64),
+        centers,
+        rots,
+        geometry.finger_width_m / 2,
+        geometry.root_z_m,
+        geometry.tip_z_m,
+    )
