@@ -288,8 +288,10 @@ def run_job(cfg: DictConfig) -> float:
 
 
 def run_in_dir(cfg: DictConfig, run_dir: Path) -> float:
-    """:func:`run_job` into ``run_dir`` (resumable, locked), outside a Hydra run (e.g. the benchmark)."""
+    """:func:`run_job` into ``run_dir`` (resumable, locked), outside a Hydra run (e.g. the benchmark). The
+    config is validated, then frozen: nothing in the job can change it (a write raises)."""
     validate(cfg)
+    OmegaConf.set_readonly(cfg, True)
     with job_lock(run_dir), threadpool_limits(limits=1):  # trials are sequential: one core per job
         return _run(cfg, run_dir)
 
