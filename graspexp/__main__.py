@@ -1,16 +1,20 @@
-"""Hydra entry point: ``python -m graspexp [group=option ...]`` runs trials for every object."""
+"""Hydra entry point: ``python -m graspexp [group=option ...]`` (or the ``graspexp`` command) runs trials
+for every object; the command line is parsed and checked first by :func:`graspexp.cli.run_checked`."""
 
 import hydra
 from omegaconf import DictConfig
 
 from graspexp.cli import run_checked
 from graspexp.config import register_configs
+from graspexp.config.registry import CONF_DIR
 from graspexp.jobs import job_failed
 
 register_configs()
 
 
-@hydra.main(version_base="1.3", config_path="../conf", config_name="config")
+@hydra.main(
+    version_base="1.3", config_path=CONF_DIR, config_name="config"
+)  # absolute: also for the console script
 def _job(cfg: DictConfig) -> float | None:
     from graspexp.datasets import DatasetError
     from graspexp.record.live import LiveViewError

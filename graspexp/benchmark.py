@@ -38,7 +38,7 @@ from omegaconf import OmegaConf
 
 from graspexp.cli import compose_config, fail
 from graspexp.compare.report import FC_MU, check_same_drops, render_markdown
-from graspexp.compare.report import success_table as noise_success_table
+from graspexp.compare.report import success_by_noise as noise_success_table
 from graspexp.config import ConfigError, PluginError, validate
 from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
 from graspexp.report.collect import collect

@@ -2,8 +2,11 @@
 
 Usage::
 
-    python -m graspexp.download dataset=ycb [dataset.root=DIR] [objects=[025_mug,011_banana]|all]
+    python -m graspexp.download dataset=ycb [dataset.root=DIR] [objects=[025_mug,011_banana]] [--all]
     python -m graspexp.download dataset=linemod [dataset.root=DIR] [--base-url URL] [--sha256 HEX]
+
+``key=value`` arguments are Hydra overrides of ``conf/config.yaml`` (one of the downloadable datasets,
+its root, the objects; default: the dataset's paper list); ``--all``: every object of its catalogue.
 
 Layout written (what :func:`graspexp.datasets.load_object` reads)::
 
@@ -37,11 +40,11 @@ import zipfile
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path, PurePosixPath
-from types import SimpleNamespace
 
 import pooch
 from filelock import FileLock, Timeout
 
+from graspexp.cli import compose_checked, tool_parser
 from graspexp.datasets.catalog import DATASETS, LINEMOD_IDS, YCB_MASS_KG, dataset_spec, resolve_root
 from graspexp.datasets.errors import DatasetError
 
@@ -279,53 +282,33 @@ def download_linemod(
     return models
 
 
-def _parse_list(value: str) -> list[str]:
-    value = value.strip()
-    if value.startswith("[") and value.endswith("]"):
-        value = value[1:-1]
-    return [item.strip().strip("'\"") for item in value.split(",") if item.strip()]
-
-
-_KEYS = ("dataset", "dataset.name", "dataset.root", "objects", "dataset.objects")
+PROG = "graspexp.download"
 
 
 def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
-    """Parse Hydra-style ``key=value`` overrides plus ``--`` flags."""
-    parser = argparse.ArgumentParser(
-        prog="python -m graspexp.download",
-        description="Download and verify YCB (google_16k) or BOP LINEMOD object meshes.",
-    )
-    parser.add_argument("overrides", nargs="*", help=f"key=value with key in {', '.join(_KEYS)}")
+    """The command line: ``--`` options, and Hydra overrides composed into the job config
+    (``dataset=``, ``dataset.root=``, ``objects=[...]``); ``root`` and ``objects`` are resolved."""
+    parser = tool_parser(PROG, "Download and verify YCB (google_16k) or BOP LINEMOD object meshes.", True)
+    parser.add_argument("--all", action="store_true", help="every object of the dataset's catalogue")
     parser.add_argument(
         "--base-url", default=None, help="base URL of the archives (default: env or official)"
     )
     parser.add_argument("--sha256", default=None, help="expected SHA-256 of lm_models.zip (mirrors)")
     parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     args = parser.parse_intermixed_args(argv)
-    values: dict[str, str] = {}
-    for item in args.overrides:
-        key, sep, value = item.partition("=")
-        key = key.lstrip("+")
-        if not sep or key not in _KEYS:
-            parser.error(f"expected key=value with key in {', '.join(_KEYS)}, got {item!r}")
-        values[{"dataset.name": "dataset", "dataset.objects": "objects"}.get(key, key)] = value
-    if "dataset" not in values:
-        parser.error("dataset=ycb or dataset=linemod is required")
-    args.dataset = values["dataset"]
-    if args.dataset not in DATASETS or not DATASETS[args.dataset].downloadable:
+    cfg = compose_checked(args.overrides, PROG)
+    args.dataset = str(cfg.dataset.name)
+    if not DATASETS[args.dataset].downloadable:
         valid = [n for n, spec in DATASETS.items() if spec.downloadable]
-        parser.error(f"dataset={args.dataset!r} cannot be downloaded; valid: {', '.join(valid)}")
-    args.root = resolve_root(SimpleNamespace(root=values.get("dataset.root")))
-    objects = _parse_list(values["objects"]) if "objects" in values else []
+        parser.error(f"dataset={args.dataset} cannot be downloaded; give dataset= one of {', '.join(valid)}")
+    args.root = resolve_root(cfg.dataset)
+    catalogue = dataset_spec(args.dataset).catalogue
+    objects = list(catalogue) if args.all else list(cfg.objects or cfg.dataset.objects or [])
     args.objects_given = bool(objects)
-    if objects == ["all"]:
-        objects = list(dataset_spec(args.dataset).catalogue)
     args.objects = objects or list(dataset_spec(args.dataset).default_objects)
-    unknown = [n for n in args.objects if n not in dataset_spec(args.dataset).catalogue]
+    unknown = [n for n in args.objects if n not in catalogue]
     if unknown:
-        parser.error(
-            f"unknown {args.dataset} objects {unknown}; valid: {', '.join(dataset_spec(args.dataset).catalogue)}"
-        )
+        parser.error(f"unknown {args.dataset} objects {unknown}; valid: {', '.join(catalogue)}")
     return args
 
 
@@ -349,7 +332,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                     f"warning: {LINEMOD_ARCHIVE} lacks the models of: {', '.join(missing)}", file=sys.stderr
                 )
     except DatasetError as err:
-        print(f"error: {err}", file=sys.stderr)
+        print(f"{PROG}: error: {err}", file=sys.stderr)
         return 2
     print(f"{len(paths)} {args.dataset} model(s) ready under {args.root.resolve()}")
     print(f"use them with dataset={args.dataset} dataset.root={args.root} (or GRASPEXP_DATA={args.root})")

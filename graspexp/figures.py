@@ -2,11 +2,12 @@
 
 Usage::
 
-    python -m graspexp.figures dataset=ycb object=025_mug [mode=bin] [out=DIR]
-    python -m graspexp.figures dataset=ycb all=true [out=DIR]
+    python -m graspexp.figures --object 025_mug [--out DIR] dataset=ycb [mode=bin]
+    python -m graspexp.figures --all [--out DIR] dataset=ycb
 
-Other arguments are Hydra overrides, as for :mod:`graspexp.plan` (the object is placed upright on the
-support the same way). Per object, in ``out`` (default ``outputs/figures/<dataset>/<object>/``):
+``key=value`` arguments are Hydra overrides, as for :mod:`graspexp.plan` (the object is placed upright on
+the support the same way, :mod:`graspexp.planning.upright`). Per object, in ``--out`` (default
+``outputs/figures/<dataset>/<object>/``):
 
 - ``fig03_cloud.png``: the complete point cloud;
 - ``fig04_area.png``: grasping area (red) and the rest (blue);
@@ -16,7 +17,7 @@ support the same way). Per object, in ``out`` (default ``outputs/figures/<datase
 - ``fig08_removed_paths.png``: the support plane (blue), kept paths (green), removed ones (grey, dashed);
 - ``fig09_grasp_pose.png``: the chosen pose (X red, Y green, Z blue), its path and the finger opening.
 
-``all=true`` draws those for every available object of the dataset into ``<out>/<object>/`` (default
+``--all`` draws those for every available object of the dataset into ``<out>/<object>/`` (default
 ``outputs/figures/<dataset>/``) and an overview grid of the areas, ``areas_overview.png`` (Figs. 12, 14).
 """
 
@@ -31,8 +32,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from graspexp.cli import compose_checked, fail, tool_parser  # noqa: E402
 from graspexp.config.gripper import GripperGeometry  # noqa: E402
-from graspexp.plan import CliError, PlannedObject, compose, load, plan_upright, split_args  # noqa: E402
+from graspexp.datasets import DatasetError, available_objects, job_object  # noqa: E402
+from graspexp.planning import NoFeasibleGrasp, UnknownPlanner  # noqa: E402
+from graspexp.planning.upright import PlannedObject, plan_upright  # noqa: E402
 
 PATH_STRIDE = 8
 """Draw one path in this many (256 paths per cluster would hide the object)."""
@@ -214,43 +218,40 @@ def draw_overview(planned: Sequence[PlannedObject], path: Path, title: str) -> P
 
 def main(argv: Sequence[str] | None = None) -> int:
     """CLI entry; returns the exit status."""
-    args, overrides = split_args(sys.argv[1:] if argv is None else argv, ("object", "out", "all"))
-    every = args.get("all", "false").lower() in ("true", "1", "yes")
-    try:
-        if not every and not args.get("object"):
-            raise CliError(
-                "give object=NAME or all=true (e.g. python -m graspexp.figures dataset=ycb object=025_mug)"
-            )
-        cfg = compose(overrides)
-        base = Path(args.get("out") or Path("outputs") / "figures" / str(cfg.dataset.name))
-        if not every:
-            planned = plan_upright(cfg, load(cfg, args["object"]))
-            out = Path(args["out"]) if args.get("out") else base / args["object"]
-            for p in draw_object(planned, out):
-                print(p)
-            return 0
-        from graspexp.datasets import available_objects
-
-        names = available_objects(cfg.dataset)
-        if not names:
-            raise CliError(f"no object of dataset {cfg.dataset.name!r} is available under the data root")
-        done = []
-        for name in names:
-            try:
-                item = plan_upright(cfg, load(cfg, name))
-            except CliError as err:
-                print(f"warning: skipped {err}", file=sys.stderr)
-                continue
-            done.append(item)
-            for p in draw_object(item, base / name):
-                print(p)
-        if done:
-            print(
-                draw_overview(done, base / "areas_overview.png", f"Grasping areas (red): {cfg.dataset.name}")
-            )
-    except CliError as err:
-        print(f"error: {err}", file=sys.stderr)
-        return 2
+    prog = "graspexp.figures"
+    parser = tool_parser(prog, __doc__.splitlines()[0], overrides=True)
+    which = parser.add_mutually_exclusive_group(required=True)
+    which.add_argument("--object", metavar="NAME", help="draw the figures of this object, e.g. 025_mug")
+    which.add_argument("--all", action="store_true", help="every available object, and the areas overview")
+    parser.add_argument(
+        "--out", type=Path, help="output folder (default outputs/figures/<dataset>[/<object>])"
+    )
+    args = parser.parse_intermixed_args(argv)
+    cfg = compose_checked(args.overrides, prog)
+    base = args.out or Path("outputs") / "figures" / str(cfg.dataset.name)
+    if args.object:
+        try:
+            planned = plan_upright(cfg, job_object(cfg, args.object))
+        except (DatasetError, NoFeasibleGrasp, UnknownPlanner) as err:
+            fail(f"{args.object}: {err}", prog)
+        for p in draw_object(planned, args.out or base / args.object):
+            print(p)
+        return 0
+    names = available_objects(cfg.dataset)
+    if not names:
+        fail(f"no object of dataset {cfg.dataset.name!r} is available under the data root", prog)
+    done = []
+    for name in names:
+        try:
+            item = plan_upright(cfg, job_object(cfg, name))
+        except (DatasetError, NoFeasibleGrasp, UnknownPlanner) as err:
+            print(f"warning: skipped {name}: {err}", file=sys.stderr)
+            continue
+        done.append(item)
+        for p in draw_object(item, base / name):
+            print(p)
+    if done:
+        print(draw_overview(done, base / "areas_overview.png", f"Grasping areas (red): {cfg.dataset.name}"))
     return 0
 
 

@@ -3,22 +3,22 @@
 Usage::
 
     python -m graspexp.prepare dataset=ycb                 # the objects a run of this config would use
-    python -m graspexp.prepare dataset=linemod --all       # every catalogue object with a mesh on disk
+    python -m graspexp.prepare --all dataset=linemod       # every catalogue object with a mesh on disk
     python -m graspexp.prepare dataset=ycb objects=[025_mug] sim.collision_method=coacd
 
-Other arguments are Hydra overrides of ``conf/config.yaml``. The runner calls :func:`prepare_shapes`
+``key=value`` arguments are Hydra overrides of ``conf/config.yaml``. The runner calls :func:`prepare_shapes`
 before its trials, so a first run shows this progress instead of sitting at 0 %.
 """
 
 import logging
 import multiprocessing
-import sys
 import time
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
 from omegaconf import DictConfig, OmegaConf
 from tqdm import tqdm
 
+from graspexp.cli import compose_checked, fail, tool_parser
 from graspexp.config import SimConfig
 from graspexp.datasets import DatasetError, available_objects, select_objects
 from graspexp.datasets.catalog import dataset_spec
@@ -95,16 +95,19 @@ def staged_objects(dataset_cfg: DictConfig) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> None:
-    from graspexp.cli import compose_config
-
+    prog = "graspexp.prepare"
+    parser = tool_parser(prog, __doc__.splitlines()[0], overrides=True)
+    parser.add_argument("--all", action="store_true", help="every catalogue object with a mesh on disk")
+    args = parser.parse_intermixed_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
-    args = list(sys.argv[1:] if argv is None else argv)
-    every = "--all" in args
-    cfg = compose_config([a for a in args if a != "--all"])
-    names = staged_objects(cfg.dataset) if every else select_objects(cfg.dataset, cfg.objects)
-    sim = OmegaConf.to_object(cfg.sim)
-    t0 = time.perf_counter()
-    prepare_shapes(cfg.dataset, sim, names)
+    cfg = compose_checked(args.overrides, prog)
+    try:
+        names = staged_objects(cfg.dataset) if args.all else select_objects(cfg.dataset, cfg.objects)
+        sim = OmegaConf.to_object(cfg.sim)
+        t0 = time.perf_counter()
+        prepare_shapes(cfg.dataset, sim, names)
+    except DatasetError as err:
+        fail(str(err), prog)
     print(f"{len(names)} collision shapes of {cfg.dataset.name} ready in {time.perf_counter() - t0:.1f} s")
 
 

@@ -9,13 +9,13 @@ Hydra multirun with the joblib launcher, resumable: running the command again sk
 A reading is one directory and one config, so no table row mixes configs.
 """
 
-import argparse
 import subprocess
 import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from graspexp.cli import tool_parser
 from graspexp.report.readings import readings_report
 
 SETTINGS_SWEEP = ("mode=collab,bin", "rot=z,xyz")
@@ -97,7 +97,7 @@ def sweep_command(reading: Reading, out: Path, datasets: str, trials: int) -> li
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m graspexp.readings", description=__doc__.splitlines()[0])
+    ap = tool_parser("graspexp.readings", __doc__.splitlines()[0])
     ap.add_argument("out", nargs="?", type=Path, default=Path("outputs/readings"), help="output folder")
     ap.add_argument("--only", default="", help=f"comma-separated names (default: all of {', '.join(ALL)})")
     ap.add_argument("--trials", type=int, default=10, help="trials per object and setting (paper: 10)")

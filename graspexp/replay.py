@@ -7,7 +7,6 @@ a corrupt, truncated or unreadable file. ``--resim`` re-simulates the trial with
 ``graspexp.sim.resim.resimulate`` and exits 0 if it agrees with the log, 1 otherwise.
 """
 
-import argparse
 import json
 import math
 import sys
@@ -15,6 +14,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from graspexp.cli import tool_parser
 from graspexp.record.reader import CorruptLogError, TrialLog, read_trial
 
 OBJECT_BODY = "object"
@@ -105,7 +105,7 @@ def format_timeline(log: TrialLog) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m graspexp.replay", description=__doc__.split("\n")[0])
+    parser = tool_parser("graspexp.replay", __doc__.split("\n")[0])
     parser.add_argument("file", help="trial log (.mcap)")
     parser.add_argument(
         "--resim", action="store_true", help="re-simulate the trial and check it agrees with the log"
@@ -115,14 +115,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         log = read_trial(args.file)
     except (CorruptLogError, OSError) as exc:
         msg = str(exc) if isinstance(exc, CorruptLogError) else f"{args.file}: {exc.strerror or exc}"
-        print(f"error: {msg}", file=sys.stderr)
+        print(f"{parser.prog}: error: {msg}", file=sys.stderr)
         return 2
     print(format_timeline(log))
     if args.resim:
         try:
             from graspexp.sim.resim import resimulate
         except ImportError as exc:
-            print(f"error: --resim needs graspexp.sim.resim ({exc})", file=sys.stderr)
+            print(f"{parser.prog}: error: --resim needs graspexp.sim.resim ({exc})", file=sys.stderr)
             return 2
         agrees, explanation = resimulate(log)
         print(f"resim: {'agrees' if agrees else 'DISAGREES'}: {explanation}")

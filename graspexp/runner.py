@@ -32,7 +32,7 @@ from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
 from graspexp.config import validate
-from graspexp.datasets import load_object, select_objects
+from graspexp.datasets import job_object, select_objects
 from graspexp.datasets.model import ObjectModel
 from graspexp.outcome import FailureReason, TrialResult
 from graspexp.planning import plan
@@ -47,7 +47,6 @@ from graspexp.record import (
     trial_recorder,
 )
 from graspexp.record.scene import ObjectScene, object_scene
-from graspexp.seeding import derive_seed
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
 
@@ -123,7 +122,7 @@ def load_models(cfg: DictConfig, objects: list[str]) -> dict[str, tuple[ObjectMo
     plain = plain_config(cfg)
     out = {}
     for name in objects:
-        model = load_object(cfg.dataset, name, cfg.planner.n_points, derive_seed(cfg.seed, "cloud", name))
+        model = job_object(cfg, name)
         hulls = collision_shape(model.mesh, plain.sim)
         out[name] = (model, hulls, object_scene(plain, hulls))
     return out
@@ -289,8 +288,10 @@ def run_job(cfg: DictConfig) -> float:
 
 
 def run_in_dir(cfg: DictConfig, run_dir: Path) -> float:
-    """:func:`run_job` into ``run_dir`` (resumable, locked), outside a Hydra run (e.g. the benchmark)."""
+    """:func:`run_job` into ``run_dir`` (resumable, locked), outside a Hydra run (e.g. the benchmark). The
+    config is validated, then frozen: nothing in the job can change it (a write raises)."""
     validate(cfg)
+    OmegaConf.set_readonly(cfg, True)
     with job_lock(run_dir), threadpool_limits(limits=1):  # trials are sequential: one core per job
         return _run(cfg, run_dir)
 

@@ -58,8 +58,9 @@ def _graph() -> dict[str, set[str]]:
 
 
 def _stage(module: str) -> str | None:
+    """The stage of ``module``; None for a tool (a top-level module, or a package's ``__main__``)."""
     parts = module.split(".")
-    return STAGE_OF_PACKAGE.get(parts[1]) if len(parts) > 1 else None
+    return STAGE_OF_PACKAGE.get(parts[1]) if len(parts) > 1 and parts[-1] != "__main__" else None
 
 
 def test_stages_import_one_way():

@@ -138,10 +138,12 @@ def test_ycb_tampered_archive_fails_clearly(server, tmp_path, capsys):
 
     ycb_archive(folder, size=0.07)  # the server now serves different bytes under the same name
     (root / download.ARCHIVE_DIR / f"{YCB_ID}_google_16k.tgz").unlink()  # e.g. a fresh machine, same root
-    argv = ["dataset=ycb", f"dataset.root={root}", f"objects={YCB_ID}", "--base-url", url, "--no-progress"]
+    argv = ["dataset=ycb", f"dataset.root={root}", f"objects=[{YCB_ID}]", "--base-url", url, "--no-progress"]
     assert download.main(argv) == 2
     err = capsys.readouterr().err
-    assert err.startswith("error: checksum mismatch for " + url + f"{YCB_ID}_google_16k.tgz")
+    assert err.startswith(
+        "graspexp.download: error: checksum mismatch for " + url + f"{YCB_ID}_google_16k.tgz"
+    )
     assert mesh.read_bytes() == original  # nothing was unpacked over the good copy
     with pytest.raises(DatasetError, match="checksum mismatch"):
         download.download_ycb(root, [YCB_ID], url=url, progress=False)
@@ -202,7 +204,7 @@ def test_cli_arguments(monkeypatch, tmp_path):
     monkeypatch.setenv("GRASPEXP_DATA", str(tmp_path))
     args = download.parse_args(["dataset=ycb", "objects=[025_mug, 011_banana]"])
     assert args.root == tmp_path and args.objects == ["025_mug", "011_banana"]
-    assert len(download.parse_args(["dataset=ycb", "objects=all"]).objects) == 23
+    assert len(download.parse_args(["dataset=ycb", "--all"]).objects) == 23
     assert download.parse_args(["dataset=linemod", "dataset.root=/x"]).root == Path("/x")
     bad_args = (
         ["dataset.root=/x"],

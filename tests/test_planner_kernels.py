@@ -13,11 +13,11 @@ import graspexp.planning.optimal as optimal
 from graspexp.config import CostConfig, DatasetConfig, OptimalConfig
 from graspexp.config.gripper import GripperGeometry
 from graspexp.datasets import available_objects, load_object
-from graspexp.plan import upright_pose
 from graspexp.planning import PlanRequest, plan
 from graspexp.planning.clusters import KMEANS_MAX_ITER, KMEANS_TOL, Clusters, max_radii_m, segment
 from graspexp.planning.cost import all_path_costs, distance_term
 from graspexp.planning.pose import grasp_rotations, slab_spans_m
+from graspexp.planning.upright import upright_pose
 
 COST = CostConfig()
 

@@ -500,7 +500,7 @@ def test_replay_corrupt_file_exit_2(trial_file, tmp_path):
     assert proc.returncode == 2
     assert proc.stdout == ""
     lines = proc.stderr.splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"error: {bad}")
+    assert len(lines) == 1 and lines[0].startswith(f"graspexp.replay: error: {bad}")
     proc = _replay(str(tmp_path / "missing.mcap"))
     assert proc.returncode == 2 and len(proc.stderr.splitlines()) == 1 and "missing.mcap" in proc.stderr
 

@@ -1,5 +1,6 @@
 """The runner's trust rules: resume reuses only logs of the same config, input errors stop a job before any
-trial is recorded, error trials are redone, one writer per directory, one line for an unusable output folder.
+trial is recorded, error trials are redone, one writer per directory, one line for an unusable output folder,
+the config frozen once validated.
 
 Each end-to-end test runs the real CLI on the offline primitives dataset with one trial of ``can``.
 """
@@ -12,10 +13,12 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from omegaconf.errors import ReadonlyConfigError
 
+from graspexp.datasets import DatasetError
 from graspexp.outcome import FailureReason, TrialResult
 from graspexp.record import TrialRecorder, read_result
-from graspexp.runner import config_differences, job_lock, job_metadata, summarize
+from graspexp.runner import config_differences, job_lock, job_metadata, run_in_dir, summarize
 from tests.conftest import compose_cfg
 
 REPO = Path(__file__).resolve().parent.parent
@@ -160,3 +163,11 @@ def test_summary_average_counts_objects_without_failures_as_zero() -> None:
     assert table.loc["mug", "slipped"] == 3 and table.loc["can", "slipped"] == 0
     assert table.loc["Average", "slipped"] == pytest.approx(1.0)
     assert table.loc["Average", "success_%"] == pytest.approx(200 / 3)
+
+
+def test_the_job_config_is_frozen_once_validated(tmp_path: Path) -> None:
+    cfg = compose_cfg("dataset=ycb", f"dataset.root={tmp_path / 'no-data'}")
+    with pytest.raises(DatasetError):  # stops at the first object, after validation
+        run_in_dir(cfg, tmp_path / "run")
+    with pytest.raises(ReadonlyConfigError):
+        cfg.trials = 3

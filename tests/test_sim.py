@@ -3,14 +3,13 @@
 import numpy as np
 import pytest
 
-from graspexp.datasets import load_object
+from graspexp.datasets import job_object
 from graspexp.geometry import make_pose
 from graspexp.outcome import FailureReason
 from graspexp.planning import plan
 from graspexp.planning.grasp import Grasp
 from graspexp.planning.request import PlanResult
 from graspexp.quality import fc_min_mu
-from graspexp.seeding import derive_seed
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.contacts import GRIPPER_LINKS
 from graspexp.sim.scene import SUPPORT_NAME
@@ -38,7 +37,7 @@ class ContactCapture(NullRecorder):
 def _ctx(*overrides, obj="can", trial=0, recorder=None, planner=plan):
     cfg = compose_cfg("dataset=primitives", *overrides)
     plain = plain_config(cfg)
-    model = load_object(cfg.dataset, obj, cfg.planner.n_points, derive_seed(cfg.seed, "cloud", obj))
+    model = job_object(cfg, obj)
     hulls = collision_shape(model.mesh, plain.sim)
     seed = trial_seed(plain, obj, trial)
     return TrialContext(

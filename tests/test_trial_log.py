@@ -9,12 +9,11 @@ import pytest
 from conftest import compose_cfg, strictly_valid
 from mcap.reader import make_reader
 
-from graspexp.datasets import load_object
+from graspexp.datasets import job_object
 from graspexp.planning import plan
 from graspexp.quality import fc_min_mu
 from graspexp.record import TrialRecorder, read_trial
 from graspexp.record.scene import object_scene
-from graspexp.seeding import derive_seed
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
 
@@ -126,7 +125,7 @@ def collab_log(tmp_path_factory) -> Path:
     """One collab trial that grasps and then removes the support, logged in-process."""
     plain = plain_config(compose_cfg("mode=collab"))
     name = "can"
-    model = load_object(plain.dataset, name, plain.planner.n_points, derive_seed(plain.seed, "cloud", name))
+    model = job_object(plain, name)
     hulls = collision_shape(model.mesh, plain.sim)
     path = tmp_path_factory.mktemp("collab") / "000.mcap"
     with TrialRecorder(path, {"object": name}) as rec:

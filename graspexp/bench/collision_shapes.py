@@ -15,7 +15,6 @@ inside it (90th percentile), how far the mesh surface lies outside the collision
 Other arguments are Hydra overrides (e.g. ``sim.coacd_threshold=0.05``).
 """
 
-import argparse
 import statistics
 import tempfile
 import time
@@ -27,12 +26,11 @@ import trimesh
 from omegaconf import OmegaConf
 from threadpoolctl import threadpool_limits
 
-from graspexp.cli import compose_config
-from graspexp.datasets import load_object
+from graspexp.cli import compose_config, tool_parser
+from graspexp.datasets import job_object
 from graspexp.planning import plan
 from graspexp.prepare import staged_objects
 from graspexp.quality import fc_min_mu
-from graspexp.seeding import derive_seed
 from graspexp.sim.collision_accuracy import shape_accuracy, surface_points, uncovered_m
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.scene import build_scene
@@ -62,7 +60,7 @@ def measure(overrides: list[str], dataset: str, name: str, trials: int, samples:
     """One row of the table for object ``name`` of ``dataset`` under the config ``overrides``."""
     cfg = compose_config([*overrides, f"dataset={dataset}", "mode=collab", "rot=z"])
     plain = plain_config(cfg)
-    model = load_object(cfg.dataset, name, cfg.planner.n_points, derive_seed(cfg.seed, "cloud", name))
+    model = job_object(cfg, name)
     with tempfile.TemporaryDirectory() as cache:
         sim = OmegaConf.to_object(cfg.sim)
         sim.cache_dir = cache
@@ -122,14 +120,13 @@ def _objects(spec: str) -> list[tuple[str, str]]:
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("overrides", nargs="*", help="Hydra overrides, e.g. sim.coacd_threshold=0.05")
+    ap = tool_parser("graspexp.bench.collision_shapes", __doc__.splitlines()[0], overrides=True)
     ap.add_argument("--objects", default="all", help="all, ycb, linemod or comma-separated names")
     ap.add_argument("--method", default="mesh", help="comma-separated sim.collision_method values")
     ap.add_argument("--trials", type=int, default=3, help="collab trials per object for trial_us")
     ap.add_argument("--samples", type=int, default=10000, help="collision-surface samples per object")
     ap.add_argument("--csv", default="outputs/bench/collision_shapes.csv", help="where to write the table")
-    args = ap.parse_args(argv)
+    args = ap.parse_intermixed_args(argv)
     threadpool_limits(limits=1)
     pairs = _objects(args.objects)
     if not pairs:

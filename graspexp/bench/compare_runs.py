@@ -6,10 +6,11 @@ digit counts. Wall-clock timing columns (``timings_s*``) are ignored. Exit statu
 identical, 1 otherwise (the differing cells are printed).
 """
 
-import argparse
 import csv
 import sys
 from pathlib import Path
+
+from graspexp.cli import tool_parser
 
 IGNORED_PREFIXES = ("timings_s",)
 """Columns that measure wall time: they differ between runs of the same config."""
@@ -48,7 +49,7 @@ def compare(before: Path, after: Path) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m graspexp.bench.compare_runs", description=__doc__)
+    parser = tool_parser("graspexp.bench.compare_runs", __doc__.splitlines()[0])
     parser.add_argument("before", type=Path, help="sweep directory of the reference run")
     parser.add_argument("after", type=Path, help="sweep directory of the run to check")
     args = parser.parse_args(argv)

@@ -2,9 +2,9 @@
 
 Usage::
 
-    GRASPEXP_DATA=/path/to/datasets python -m graspexp.bench.plan_latency [--repeats 5] [--runs 30] [override ...]
+    GRASPEXP_DATA=/path/to/datasets python -m graspexp.bench.plan_latency [--repeats 5] [--runs 30] [key=value ...]
 
-Each object stands upright on the support as in :mod:`graspexp.plan` (N = ``planner.n_points``, default
+Each object stands upright on the support (:mod:`graspexp.planning.upright`) (N = ``planner.n_points``, default
 2048; M = ``planner.m``, default 256), in each mode. One repeat times ``--runs`` plans after a warm-up
 and takes their p50 and p95, on the wall clock and as CPU time of this thread (the figure that stays
 stable when other processes share the machine); the table shows the median over repeats of each.
@@ -25,7 +25,6 @@ import os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-import argparse  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 from collections.abc import Callable, Sequence  # noqa: E402
@@ -34,12 +33,13 @@ import numba  # noqa: E402
 import numpy as np  # noqa: E402
 from threadpoolctl import threadpool_limits  # noqa: E402
 
-from graspexp.datasets import dataset_objects  # noqa: E402
-from graspexp.plan import CliError, compose, load, upright_request  # noqa: E402
+from graspexp.cli import compose_checked, fail, tool_parser  # noqa: E402
+from graspexp.datasets import DatasetError, dataset_objects, job_object  # noqa: E402
 from graspexp.planning import PlanRequest, kernels, plan  # noqa: E402
 from graspexp.planning.clusters import segment  # noqa: E402
 from graspexp.planning.cost import M_TO_MM  # noqa: E402
 from graspexp.planning.optimal import kmeans_random_state, paper_candidates, path_costs  # noqa: E402
+from graspexp.planning.upright import upright_request  # noqa: E402
 
 PAPER_PLAN_S = 0.1
 """The paper's planner time (clusters + paths + cost), seconds (IV-F, i7-9700)."""
@@ -121,35 +121,33 @@ def first_plan_s(req: PlanRequest) -> tuple[float, str]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(
-        prog="python -m graspexp.bench.plan_latency", description=__doc__.split("\n")[0]
-    )
+    parser = tool_parser("graspexp.bench.plan_latency", __doc__.split("\n")[0], overrides=True)
     parser.add_argument("--repeats", type=int, default=5, help="repeats per object and mode (median taken)")
     parser.add_argument("--runs", type=int, default=30, help="timed plans per repeat")
-    args, overrides = parser.parse_known_args(sys.argv[1:] if argv is None else argv)
+    args = parser.parse_intermixed_args(argv)
+    prog = parser.prog
+    cfg = compose_checked(["dataset=ycb", *args.overrides], prog)
+    dataset = str(cfg.dataset.name)
+    names = dataset_objects(cfg.dataset)
     try:
-        cfg = compose(["dataset=ycb", *overrides])
-        dataset = str(cfg.dataset.name)
-        names = dataset_objects(cfg.dataset)
+        job_object(cfg, names[0])
+    except DatasetError as err:
+        print(f"note: {dataset} meshes unavailable ({err}); falling back to the primitives dataset")
+        cfg = compose_checked([*args.overrides, "dataset=primitives"], prog)
+        dataset, names = "primitives", dataset_objects(cfg.dataset)
+    rows = []  # (name, mode, K, area size, request)
+    first = None
+    for name in names:
         try:
-            load(cfg, names[0])
-        except CliError as err:
-            print(f"note: {dataset} meshes unavailable ({err}); falling back to the primitives dataset")
-            cfg = compose([*overrides, "dataset=primitives"])
-            dataset, names = "primitives", dataset_objects(cfg.dataset)
-        rows = []  # (name, mode, K, area size, request)
-        first = None
-        for name in names:
-            model = load(cfg, name)
-            for mode in MODES:
-                cfg.mode.name = mode
-                req = upright_request(cfg, model)
-                if first is None:
-                    first = first_plan_s(req)
-                rows.append((name, mode, plan(req).grasp.extras["K"], int(model.area_mask.sum()), req))
-    except CliError as err:
-        print(f"error: {err}", file=sys.stderr)
-        return 2
+            model = job_object(cfg, name)
+        except DatasetError as err:
+            fail(str(err), prog)
+        for mode in MODES:
+            cfg.mode.name = mode
+            req = upright_request(cfg, model)
+            if first is None:
+                first = first_plan_s(req)
+            rows.append((name, mode, plan(req).grasp.extras["K"], int(model.area_mask.sum()), req))
     with threadpool_limits(limits=1):
         calls = [timed_calls(req) for *_, req in rows]
         sqrt_ns = sqrt_bound_ns(args.repeats)

@@ -10,7 +10,6 @@ built once, as the runner does. Figures are medians over trials (per-phase, rati
 (throughput); CPU time per thread is printed beside wall time.
 """
 
-import argparse
 import statistics
 import tempfile
 import time
@@ -20,13 +19,12 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from graspexp.cli import compose_config
-from graspexp.datasets import available_objects, load_object
+from graspexp.cli import compose_checked, compose_config, tool_parser
+from graspexp.datasets import available_objects, job_object
 from graspexp.planning import plan
 from graspexp.quality import fc_min_mu
 from graspexp.record import TrialRecorder
 from graspexp.record.scene import object_scene
-from graspexp.seeding import derive_seed
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial, trial_seed
 
@@ -61,8 +59,7 @@ class _Object:
         cfg = compose_config(overrides)
         self.plain = plain_config(cfg)
         self.name = name
-        seed = derive_seed(cfg.seed, "cloud", name)
-        self.model = load_object(cfg.dataset, name, cfg.planner.n_points, seed)
+        self.model = job_object(cfg, name)
         self.hulls = collision_shape(self.model.mesh, self.plain.sim)
         self.scene = object_scene(self.plain, self.hulls)
 
@@ -190,18 +187,17 @@ def report_mode(mode: str, rows: dict[str, list[dict]], log_rate_hz: float) -> N
 
 
 def main(argv: list[str] | None = None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("overrides", nargs="*", help="Hydra overrides, e.g. dataset=ycb")
+    ap = tool_parser("graspexp.bench.trials", __doc__.splitlines()[0], overrides=True)
     ap.add_argument(
         "--modes", default="collab,bin", help="comma-separated modes, measured one after the other"
     )
     ap.add_argument("--trials", type=int, default=10, help="trials per object")
     ap.add_argument("--objects", default="", help="comma-separated subset")
     ap.add_argument("--repeats", type=int, default=3, help="repeats of the throughput runs (0: skip them)")
-    args = ap.parse_args(argv)
+    args = ap.parse_intermixed_args(argv)
     threadpool_limits(limits=1)
     modes = args.modes.split(",")
-    cfg = compose_config([*args.overrides, f"mode={modes[0]}"])
+    cfg = compose_checked([*args.overrides, f"mode={modes[0]}"], ap.prog)
     names = args.objects.split(",") if args.objects else available_objects(cfg.dataset)
     print(
         f"trial benchmark: {cfg.dataset.name} rot={cfg.rot.name}, modes {modes}, {len(names)} objects x {args.trials}"

@@ -10,7 +10,7 @@ from graspexp.compare.report import (
     collect_trials,
     plot_success_vs_noise,
     render_markdown,
-    success_table,
+    success_by_noise,
     write_comparison,
 )
 
@@ -21,6 +21,6 @@ __all__ = [
     "collect_trials",
     "plot_success_vs_noise",
     "render_markdown",
-    "success_table",
+    "success_by_noise",
     "write_comparison",
 ]

@@ -4,15 +4,15 @@ Writes ``compare.md``, ``compare.csv`` and ``success_vs_noise.png`` to OUT (defa
 and prints the Markdown. Exit status 2 when DIR holds no readable trial log.
 """
 
-import argparse
 import sys
 from pathlib import Path
 
+from graspexp.cli import tool_parser
 from graspexp.compare.report import write_comparison
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m graspexp.compare", description=__doc__.splitlines()[0])
+    ap = tool_parser("graspexp.compare", __doc__.splitlines()[0])
     ap.add_argument("dir", type=Path, help="run or multirun directory holding trials/<object>/<NNN>.mcap")
     ap.add_argument("--out", type=Path, default=None, help="output folder (default: DIR/compare)")
     args = ap.parse_args(argv)

@@ -33,7 +33,7 @@ from mcap.reader import make_reader  # noqa: E402
 from graspexp.record import CorruptLogError, read_result  # noqa: E402
 from graspexp.record.schemas import METADATA_NAME  # noqa: E402
 from graspexp.report.collect import find_trial_logs  # noqa: E402
-from graspexp.report.stats import wilson_interval  # noqa: E402
+from graspexp.report.stats import success_pct  # noqa: E402
 
 SETTING_KEYS: tuple[str, ...] = ("dataset", "mode", "rot")
 """Result fields that name a setting (besides the noise level)."""
@@ -81,20 +81,20 @@ def collect_trials(root: Path | str) -> tuple[pd.DataFrame, list[str]]:
     return df[~dup].reset_index(drop=True), warnings
 
 
-def success_table(df: pd.DataFrame) -> pd.DataFrame:
+def success_by_noise(df: pd.DataFrame) -> pd.DataFrame:
     """Success per (dataset, mode, rot, trans_mm, rot_deg, planner) with Wilson 95 % bounds, in %."""
     out = []
     for key, g in df.groupby([*GROUP_KEYS, "planner"], sort=True):
         n, k = len(g), int(g["success"].sum())
-        lo, hi = wilson_interval(k, n)
+        pct, lo_pct, hi_pct = success_pct(k, n)
         out.append(
             {
                 **dict(zip([*GROUP_KEYS, "planner"], key, strict=True)),
                 "n": n,
                 "successes": k,
-                "success_pct": 100.0 * k / n,
-                "ci_lo_pct": 100.0 * lo,
-                "ci_hi_pct": 100.0 * hi,
+                "success_pct": pct,
+                "ci_lo_pct": lo_pct,
+                "ci_hi_pct": hi_pct,
             }
         )
     cols = [*GROUP_KEYS, "planner", "n", "successes", "success_pct", "ci_lo_pct", "ci_hi_pct"]
@@ -209,12 +209,11 @@ def _panel(ax, df: pd.DataFrame, key: str, other: str, unit: str) -> None:
     for planner, g in sub.groupby("planner", sort=True):
         xs, ys, lo, hi = [], [], [], []
         for level, h in g.groupby(key, sort=True):
-            n, k = len(h), int(h["success"].sum())
-            a, b = wilson_interval(k, n)
+            pct, lo_pct, hi_pct = success_pct(int(h["success"].sum()), len(h))
             xs.append(level)
-            ys.append(100.0 * k / n)
-            lo.append(100.0 * (k / n - a))
-            hi.append(100.0 * (b - k / n))
+            ys.append(pct)
+            lo.append(pct - lo_pct)
+            hi.append(hi_pct - pct)
         ax.errorbar(xs, ys, yerr=[lo, hi], marker="o", capsize=3, label=planner)
     note = f"{other} = 0" if sub is not df else f"all {other}"
     ax.set(
@@ -240,7 +239,7 @@ def write_comparison(root: Path | str, out: Path | str | None = None) -> tuple[s
     root = Path(root)
     out = Path(out) if out is not None else root / "compare"
     df, warnings = collect_trials(root)
-    table = success_table(df)
+    table = success_by_noise(df)
     drops = check_same_drops(df)
     quality = quality_table(df)
     md = render_markdown(table, drops, warnings) + render_quality(quality)

@@ -1,8 +1,8 @@
 """Structured Hydra configs: one schema dataclass per config group, registered in the ConfigStore.
 
-Every YAML option under ``conf/<group>/`` lists its schema (``base_<group>``; for a planner
-``base_<planner name>``, from its plugin) first in its defaults, so Hydra type-checks every option and
-rejects unknown keys. Nothing here imports Hydra (only :func:`register_configs` does, when called).
+Every YAML option under ``conf/<group>/`` lists its schema (``/schema_<group>@_here_``; for a planner
+``/schema_planner_<planner name>@_here_``, from its plugin) first in its defaults, so Hydra type-checks
+every option and rejects unknown keys. The schemas are stored outside the groups, so none is an option. Nothing here imports Hydra (only :func:`register_configs` does, when called).
 """
 
 from graspexp.config.cost import CostConfig

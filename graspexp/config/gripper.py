@@ -34,6 +34,36 @@ class GripperConfig:
     """Mass of each finger, kg."""
     tcp_from_tip_m: float = 0.01
     """Distance from the fingertips back to the TCP (the grasp point, the pads' centre) along -Z, m."""
+    arm_stiffness_n_per_m: float = 2.0e4
+    """Drive stiffness of the simulated arm's three translation joints, N/m."""
+    arm_damping_ns_per_m: float = 4.0e2
+    """Drive damping of the arm's translation joints, N s/m."""
+    arm_force_limit_n: float = 400.0
+    """Force limit of the arm's translation drives, N."""
+    wrist_stiffness_nm_per_rad: float = 2.0e3
+    """Drive stiffness of the three wrist rotation joints (held at their start), N m/rad."""
+    wrist_damping_nms_per_rad: float = 5.0e1
+    """Drive damping of the wrist joints, N m s/rad."""
+    wrist_torque_limit_nm: float = 200.0
+    """Torque limit of the wrist drives, N m."""
+    finger_stiffness_n_per_m: float = 2.0e3
+    """Drive stiffness of each finger joint, N/m (its force limit is ``grip_force_n``)."""
+    finger_damping_ns_per_m: float = 1.0e2
+    """Drive damping of each finger joint, N s/m."""
+    coupling_stiffness_n_per_m: float = 1.0e5
+    """Stiffness of the fixed tendon that keeps both fingers at the same opening, N/m."""
+    coupling_damping_ns_per_m: float = 1.0e3
+    """Damping of that tendon, N s/m."""
+    close_past_m: float = 0.02
+    """How far past fully closed (q = 0) a finger may travel, m: its joint's lower limit is -this, so the
+    limit never takes part of the squeeze on a thin object (with the limit at 0, a 10 mm box got 88 of
+    100 N even with the target far past it)."""
+    close_force_margin: float = 2.0
+    """The finger target lies this many times ``grip_force_n / finger_stiffness_n_per_m`` past closed (at
+    least ``close_past_m``), so the drive's spring force at any contact is >= this x ``grip_force_n`` and the
+    force limit alone sets the squeeze. PhysX's implicit drive delivers less than its limit when the spring
+    barely exceeds it (measured on a 10 mm box, Robotiq 100 N: margin 1.1 -> 94 N, 1.5 -> 99.5 N, 2 ->
+    100 N)."""
 
 
 @dataclass(frozen=True)
@@ -122,5 +152,17 @@ CONSTRAINTS = {
     "pad_friction": [Interval(0, 5)],
     "finger_mass_kg": [Interval(0, 10, "right", "kg")],
     "tcp_from_tip_m": [Interval(0, 0.5, unit="m")],
+    "arm_stiffness_n_per_m": [Interval(0, 1e9, "right", "N/m")],
+    "arm_damping_ns_per_m": [Interval(0, 1e9, unit="N s/m")],
+    "arm_force_limit_n": [Interval(0, 1e6, "right", "N")],
+    "wrist_stiffness_nm_per_rad": [Interval(0, 1e9, "right", "N m/rad")],
+    "wrist_damping_nms_per_rad": [Interval(0, 1e9, unit="N m s/rad")],
+    "wrist_torque_limit_nm": [Interval(0, 1e6, "right", "N m")],
+    "finger_stiffness_n_per_m": [Interval(0, 1e9, "right", "N/m")],
+    "finger_damping_ns_per_m": [Interval(0, 1e9, unit="N s/m")],
+    "coupling_stiffness_n_per_m": [Interval(0, 1e9, "right", "N/m")],
+    "coupling_damping_ns_per_m": [Interval(0, 1e9, unit="N s/m")],
+    "close_past_m": [Interval(0, 0.5, unit="m")],
+    "close_force_margin": [Interval(1, 100)],
 }
 """Allowed values of every key (see :mod:`graspexp.config.constraints`)."""

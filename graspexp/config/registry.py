@@ -1,4 +1,5 @@
-"""Registers every schema in Hydra's ConfigStore (``base_<group>`` in each group; one schema per planner)."""
+"""Registers every schema in Hydra's ConfigStore, outside the config groups (``schema_<group>``, one
+``schema_planner_<name>`` per planner), so that no schema is offered as an option (``--help``, completion)."""
 
 from pathlib import Path
 
@@ -40,22 +41,28 @@ def group_options(group: str) -> list[str]:
     return sorted(names)
 
 
+def schema_name(group: str, planner: str | None = None) -> str:
+    """The ConfigStore name of a group's schema (of the planner ``planner`` for ``group="planner"``): a
+    top-level entry, not an option of the group; an option's YAML lists it as ``/<name>@_here_``."""
+    return f"schema_planner_{planner}" if group == "planner" else f"schema_{group}"
+
+
 def register_configs() -> None:
-    """Store ``base_job``, one ``base_<group>`` schema per group, and per installed planner its schema as
-    ``planner/base_<name>`` plus, unless ``conf/planner/<name>.yaml`` is its preset, the option
+    """Store the job schema (``schema_job``), one schema per group and per installed planner
+    (:func:`schema_name`), and per planner without a preset ``conf/planner/<name>.yaml`` the option
     ``planner/<name>`` (the schema's defaults); safe to call twice. Broken plugins are skipped here (their
     error is raised when one is selected, see :func:`graspexp.config.plugins.get_plugin`)."""
     from hydra.core.config_store import ConfigStore  # here, so that the schemas load without Hydra
 
     cs = ConfigStore.instance()
-    cs.store(name="base_job", node=JobConfig)
+    cs.store(name=schema_name("job"), node=JobConfig)
     for group, schema in SCHEMAS.items():
-        cs.store(group=group, name=f"base_{group}", node=schema)
+        cs.store(name=schema_name(group), node=schema)
     presets = _yaml_options("planner")
     for name, found in load_planners().items():
         if isinstance(found, LoadedPlanner):
             schema = found.plugin.config
-            cs.store(group="planner", name=f"base_{name}", node=schema)
+            cs.store(name=schema_name("planner", name), node=schema)
             if name not in presets:
                 cs.store(group="planner", name=name, node=schema(name=name))
 

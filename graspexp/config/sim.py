@@ -41,6 +41,15 @@ class SimConfig:
     the paper's criterion (IV-C), success = the object is still held; the slip is recorded either way."""
     max_speed_mps: float = 20.0
     """Any body faster than this (or NaN) means the simulation blew up, m/s."""
+    max_angular_speed_radps: float = 1.0e6
+    """An object spinning faster than this (or NaN) means the simulation blew up, rad/s."""
+    fell_below_m: float = 0.05
+    """While settling, an object whose origin is this far below the support plane has fallen off it, m."""
+    on_support_tolerance_m: float = 0.01
+    """A settled object rests on the support when its lowest point is less than this below the support
+    top (and its centre of mass is over the support), m."""
+    min_finger_force_n: float = 0.5
+    """A finger holds the object when it presses with at least this force, N."""
     log_rate_hz: float = 30.0
     """Sim-time rate of transforms and contacts in the MCAP log, Hz."""
     collision_method: str = "mesh"
@@ -110,6 +119,10 @@ CONSTRAINTS = {
     "retract_speed_mps": [Interval(0, 10, "right", "m/s")],
     "slip_threshold_m": [None, Interval(0, 1, "right", "m")],
     "max_speed_mps": [Interval(0, 1000, "right", "m/s")],
+    "max_angular_speed_radps": [Interval(0, 1e9, "right", "rad/s")],
+    "fell_below_m": [Interval(0, 10, "right", "m")],
+    "on_support_tolerance_m": [Interval(0, 1, "right", "m")],
+    "min_finger_force_n": [Interval(0, 1000, "right", "N")],
     "log_rate_hz": [Interval(0, 1000, "right", "Hz")],
     "collision_method": [Options(("mesh", "coacd", "vhacd"))],
     "mesh_max_faces": [Interval(64, None, integer=True)],

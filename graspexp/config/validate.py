@@ -2,7 +2,7 @@
 
 Every key's allowed values are declared as data next to its schema (``CONSTRAINTS`` in each schema
 module, see :mod:`graspexp.config.constraints`); this module walks the composed config against the
-schemas: unknown keys (``+foo=1``), keys left without a value (``mode=base_mode``), values out of range,
+schemas: unknown keys (``+foo=1``), keys left without a value (``???``), values out of range,
 and the few relations between keys. Every message is one line naming the dotted key, the value and the
 allowed range.
 """
@@ -91,8 +91,7 @@ def _missing(dotted: str) -> None:
     group = dotted.split(".")[0]
     if group in SCHEMAS or group == "planner":
         raise ConfigError(
-            f"{group}.{dotted.split('.', 1)[-1]} has no value: {group}=base_{'<planner>' if group == 'planner' else group} is the schema, not an "
-            f"option; expected {group}= one of {', '.join(group_options(group))}"
+            f"{dotted} has no value: choose an option, {group}= one of {', '.join(group_options(group))}"
         )
     raise ConfigError(f"{dotted} has no value: set it with {dotted}=...")
 

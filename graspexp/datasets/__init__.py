@@ -3,6 +3,7 @@
 Public API (the simulator and planner import these names)::
 
     load_object(cfg, name, n_points, seed) -> ObjectModel
+    job_object(job_cfg, name) -> ObjectModel (the job's cloud size and cloud seed)
     resolve_root(cfg) -> pathlib.Path
     dataset_objects(cfg) -> list[str]
     available_objects(cfg) -> list[str]
@@ -15,7 +16,7 @@ Public API (the simulator and planner import these names)::
 from graspexp.datasets import primitives
 from graspexp.datasets.catalog import available_objects, dataset_objects, resolve_root
 from graspexp.datasets.errors import DatasetError
-from graspexp.datasets.loader import load_object, select_objects
+from graspexp.datasets.loader import job_object, load_object, select_objects
 from graspexp.datasets.model import ObjectModel
 from graspexp.datasets.regions import import_meshlab_area
 
@@ -25,6 +26,7 @@ __all__ = [
     "available_objects",
     "dataset_objects",
     "import_meshlab_area",
+    "job_object",
     "load_object",
     "primitives",
     "resolve_root",

@@ -27,6 +27,7 @@ examined), ``best_pair`` (2,).
 import numpy as np
 
 from graspexp.planning.collision import frame_from_axes, place_for_request
+from graspexp.planning.friction import cone_cosine, line_cone_cosines
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.request import PlanRequest, PlanResult
 
@@ -63,15 +64,11 @@ def antipodal_pairs(
     angles_deg : (P,) float64 worse cone angle of each pair, degrees.
     """
     p1, n1 = points_m[seeds], normals[seeds]
-    v = points_m[None, :, :] - p1[:, None, :]  # (S, N, 3)
-    d = np.linalg.norm(v, axis=2)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        v = v / d[..., None]
-    cos1 = -np.einsum("sj,snj->sn", n1, v)  # v against the inward normal at p1
-    cos2 = np.einsum("nj,snj->sn", normals, v)  # -v against the inward normal at p2
+    d, cos1, cos2 = line_cone_cosines(  # (S, N): every seed against every point
+        p1[:, None, :], n1[:, None, :], points_m[None, :, :], normals[None, :, :]
+    )
     worst = np.minimum(cos1, cos2)
-    cone = np.cos(np.arctan(friction_coef))
-    valid = (d > 0) & (d <= max_distance_m) & (worst >= cone)
+    valid = (d > 0) & (d <= max_distance_m) & (worst >= cone_cosine(friction_coef))
     worst = np.where(valid, worst, -np.inf)
     partner = np.argmax(worst, axis=1)
     keep = valid[np.arange(len(seeds)), partner]

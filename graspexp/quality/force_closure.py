@@ -1,12 +1,8 @@
 """Two-contact force closure, as GraspNet-1Billion scores grasps (the dex-net test).
 
 A parallel-jaw grasp touches the object at two points ``p1``, ``p2`` with OUTWARD unit surface normals
-``n1``, ``n2``. With Coulomb friction ``mu`` each finger can push along any direction inside the cone of
-half-angle ``atan(mu)`` about the inward normal. Two such contacts are in force closure exactly when the
-line joining them lies inside both cones (Nguyen 1988):
-
-    angle(v, -n1) <= atan(mu)   and   angle(-v, -n2) <= atan(mu),   v = (p2 - p1) / |p2 - p1|.
-
+``n1``, ``n2``; they are in force closure for friction ``mu`` when the line joining them lies inside both
+friction cones (the test in :mod:`graspexp.planning.friction`, which the antipodal planner uses too).
 :func:`min_friction_for_closure` returns the smallest ``mu`` of a list (GraspNet uses 0.2 ... 1.2 in
 steps of 0.2; lower is a better grasp) for which that holds, ``inf`` if none does.
 
@@ -23,6 +19,7 @@ import math
 import numpy as np
 import trimesh
 
+from graspexp.planning.friction import line_cone_cosines
 from graspexp.planning.grasp import Grasp
 
 DEFAULT_MUS = (0.2, 0.4, 0.6, 0.8, 1.0, 1.2)
@@ -40,14 +37,14 @@ def cone_angles_rad(p1: np.ndarray, n1: np.ndarray, p2: np.ndarray, n2: np.ndarr
 
     p1, p2 : (3,) contact points, m; n1, n2 : (3,) outward normals (normalised here).
     """
-    v = np.asarray(p2, dtype=np.float64) - np.asarray(p1, dtype=np.float64)
-    d = float(np.linalg.norm(v))
     m1, m2 = float(np.linalg.norm(n1)), float(np.linalg.norm(n2))
+    d, cos1, cos2 = line_cone_cosines(
+        p1, np.asarray(n1, dtype=np.float64), p2, np.asarray(n2, dtype=np.float64)
+    )
     if d == 0.0 or m1 == 0.0 or m2 == 0.0:
         return (math.pi, math.pi)
-    v /= d
-    c1 = float(np.clip(-(np.asarray(n1, dtype=np.float64) @ v) / m1, -1.0, 1.0))
-    c2 = float(np.clip((np.asarray(n2, dtype=np.float64) @ v) / m2, -1.0, 1.0))
+    c1 = float(np.clip(cos1 / m1, -1.0, 1.0))
+    c2 = float(np.clip(cos2 / m2, -1.0, 1.0))
     return (math.acos(c1), math.acos(c2))
 
 

@@ -4,15 +4,15 @@ DIR is a run directory or a multirun (sweep) directory; every ``trials/<object>/
 is read. The report goes to ``DIR/report/`` (or OUT) and its Markdown is printed.
 """
 
-import argparse
 import sys
 from pathlib import Path
 
+from graspexp.cli import tool_parser
 from graspexp.report.build import build_report, write_report
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m graspexp.report", description=__doc__.splitlines()[0])
+    parser = tool_parser("graspexp.report", __doc__.splitlines()[0])
     parser.add_argument("dir", type=Path, help="run or multirun directory holding trials/**/*.mcap")
     parser.add_argument("--out", type=Path, default=None, help="output folder (default: DIR/report)")
     parser.add_argument(

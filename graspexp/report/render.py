@@ -142,13 +142,18 @@ def latex_escape(text: object) -> str:
 
 
 def latex(df: pd.DataFrame, caption: str = "", index: bool = True) -> str:
-    """A booktabs ``tabular`` (inside a ``table`` with caption) for a frame of strings or numbers."""
+    """A booktabs ``tabular`` (inside a ``table`` with caption) for a frame of strings or numbers, scaled
+    down to the text width when wider (``\\resizebox``; needs the booktabs and graphicx packages).
+
+    Written here rather than with pandas ``Styler.to_latex``: that needs jinja2 (a further dependency) and
+    leaves the caption unescaped, while planner names in captions carry ``_``."""
     frame = df.reset_index() if index else df
     cols = [latex_escape(c) for c in frame.columns]
     lines = [
         r"\begin{table}[ht]",
         r"\centering",
         rf"\caption{{{latex_escape(caption)}}}" if caption else "",
+        r"\resizebox{\ifdim\width>\linewidth\linewidth\else\width\fi}{!}{%",
         r"\begin{tabular}{l" + "r" * (len(cols) - 1) + "}",
         r"\toprule",
         " & ".join(cols) + r" \\",
@@ -161,5 +166,5 @@ def latex(df: pd.DataFrame, caption: str = "", index: bool = True) -> str:
                 v = NA if math.isnan(v) else f"{v:.4g}"
             cells.append(latex_escape(v))
         lines.append(" & ".join(cells) + r" \\")
-    lines += [r"\bottomrule", r"\end{tabular}", r"\end{table}"]
+    lines += [r"\bottomrule", r"\end{tabular}}", r"\end{table}"]
     return "\n".join(ln for ln in lines if ln) + "\n"

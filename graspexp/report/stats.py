@@ -1,4 +1,5 @@
-"""Small statistics for success rates and timings: the Wilson score interval and percentiles."""
+"""Small statistics for success rates and timings: the Wilson score interval, a rate with its interval in
+%, and percentiles."""
 
 import math
 from collections.abc import Iterable
@@ -30,6 +31,13 @@ def wilson_interval(successes: int, trials: int, z: float = Z_95) -> tuple[float
     lo, hi = centre - half, centre + half
     # exact ends: at k = 0 the lower bound is 0, at k = n the upper bound is 1 (rounding aside)
     return (0.0 if k == 0 else max(0.0, lo), 1.0 if k == n else min(1.0, hi))
+
+
+def success_pct(successes: int, trials: int) -> tuple[float, float, float]:
+    """``(rate, lo, hi)`` in %: the success rate of ``successes`` in ``trials`` and its Wilson 95 % interval
+    (:func:`wilson_interval`); nan for each when ``trials == 0``."""
+    lo, hi = wilson_interval(successes, trials)
+    return (100.0 * successes / trials if trials else math.nan, 100.0 * lo, 100.0 * hi)
 
 
 def percentiles(values: Iterable[float], qs: tuple[float, ...] = (50, 95)) -> tuple[float, ...]:

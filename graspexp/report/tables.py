@@ -19,7 +19,7 @@ from graspexp.report.paper import (
     SETTINGS,
     PaperTable,
 )
-from graspexp.report.stats import percentiles, wilson_interval
+from graspexp.report.stats import percentiles, success_pct
 
 AVERAGE = "Average"
 AVERAGE_SAME = "Paper avg., same objects"
@@ -56,15 +56,15 @@ def _settings_for(df: pd.DataFrame) -> list[tuple[str, str]]:
 
 def _cell(sub: pd.DataFrame) -> dict:
     n, k = len(sub), int(sub["success"].sum())
-    lo, hi = wilson_interval(k, n)
+    pct, lo_pct, hi_pct = success_pct(k, n)
     reasons = sub.loc[~sub["success"], "reason"].fillna("(none)").value_counts().sort_index()
     reasons = reasons.sort_values(ascending=False, kind="stable")
     return {
         "n": n,
         "successes": k,
-        "ours_pct": 100.0 * k / n if n else math.nan,
-        "lo_pct": 100.0 * lo,
-        "hi_pct": 100.0 * hi,
+        "ours_pct": pct,
+        "lo_pct": lo_pct,
+        "hi_pct": hi_pct,
         "top_reason": str(reasons.index[0]) if len(reasons) else "",
         "top_reason_n": int(reasons.iloc[0]) if len(reasons) else 0,
     }

@@ -28,24 +28,8 @@ _AXIS_Q = {
 }
 FINGER_NAMES = ("finger_left", "finger_right")
 PALM_NAME = "palm"
-ARM_STIFFNESS, ARM_DAMPING, ARM_FORCE_N = 2.0e4, 4.0e2, 400.0
-"""Translation drives: N/m, N s/m, N."""
-WRIST_STIFFNESS, WRIST_DAMPING, WRIST_TORQUE_NM = 2.0e3, 5.0e1, 200.0
-"""Rotation drives: N m/rad, N m s/rad, N m."""
 N_BASE = 6
 """Base joints before the two fingers: 3 prismatic then 3 revolute."""
-FINGER_STIFFNESS, FINGER_DAMPING = 2.0e3, 1.0e2
-COUPLING_STIFFNESS, COUPLING_DAMPING = 1.0e5, 1.0e3
-"""Fixed tendon that keeps both fingers at the same opening (N/m, N s/m)."""
-CLOSE_PAST_M = 0.02
-"""How far past fully closed (q = 0) a finger may travel, m: its joint's lower limit is -CLOSE_PAST_M, so
-the limit never takes part of the squeeze on a thin object (with the limit at 0, a 10 mm box got 88 of
-100 N even with the target far past it)."""
-CLOSE_FORCE_MARGIN = 2.0
-"""The finger target lies this many times grip_force_n / FINGER_STIFFNESS past closed (at least
-CLOSE_PAST_M), so the drive's spring force at any contact is >= 2 x grip_force_n and the force limit alone
-sets the squeeze. PhysX's implicit drive delivers less than its limit when the spring barely exceeds it
-(measured on a 10 mm box, Robotiq 100 N: margin 1.1 -> 94 N, 1.5 -> 99.5 N, 2 -> 100 N)."""
 
 
 @dataclass
@@ -55,7 +39,7 @@ class Gripper:
     fingers: tuple[sapien.physx.PhysxArticulationLinkComponent, sapien.physx.PhysxArticulationLinkComponent]
     joints: list
     close_target_m: float
-    """Finger joint target when closing (negative: past fully closed), m; see :data:`CLOSE_FORCE_MARGIN`."""
+    """Finger joint target when closing (negative: past fully closed), m; see ``gripper.close_force_margin``."""
     arm_targets: list[float] = field(default_factory=lambda: [math.nan] * 3)
     """The x, y, z drive targets last set, m (NaN: none yet)."""
 
@@ -123,7 +107,7 @@ def build_gripper(
         f.set_joint_name(name)
         q = _AXIS_Q[axis]
         f.set_joint_properties(
-            "prismatic", [[-CLOSE_PAST_M, cfg.max_width_m / 2]], sapien.Pose(q=q), sapien.Pose(q=q)
+            "prismatic", [[-cfg.close_past_m, cfg.max_width_m / 2]], sapien.Pose(q=q), sapien.Pose(q=q)
         )
         box = geometry.finger(sign)
         center = list(box.center)
@@ -140,13 +124,23 @@ def build_gripper(
         set_groups(lk, GRIPPER_BIT, mask)
     joints = list(art.active_joints)
     for j in joints[:3]:
-        j.set_drive_properties(stiffness=ARM_STIFFNESS, damping=ARM_DAMPING, force_limit=ARM_FORCE_N)
+        j.set_drive_properties(
+            stiffness=cfg.arm_stiffness_n_per_m,
+            damping=cfg.arm_damping_ns_per_m,
+            force_limit=cfg.arm_force_limit_n,
+        )
     for j in joints[3:N_BASE]:
-        j.set_drive_properties(stiffness=WRIST_STIFFNESS, damping=WRIST_DAMPING, force_limit=WRIST_TORQUE_NM)
+        j.set_drive_properties(
+            stiffness=cfg.wrist_stiffness_nm_per_rad,
+            damping=cfg.wrist_damping_nms_per_rad,
+            force_limit=cfg.wrist_torque_limit_nm,
+        )
         j.set_drive_target(0.0)
     for j in joints[N_BASE:]:
         j.set_drive_properties(
-            stiffness=FINGER_STIFFNESS, damping=FINGER_DAMPING, force_limit=float(cfg.grip_force_n)
+            stiffness=cfg.finger_stiffness_n_per_m,
+            damping=cfg.finger_damping_ns_per_m,
+            force_limit=float(cfg.grip_force_n),
         )
     links = {lk.name: lk for lk in art.links}
     # couple the fingers like a real parallel gripper's linkage: q_left - q_right -> 0, stiffly
@@ -154,13 +148,15 @@ def build_gripper(
         [links[PALM_NAME], links["finger_left"], links["finger_right"]],
         [0.0, 1.0, -1.0],
         [0.0, 1.0, -1.0],
-        stiffness=COUPLING_STIFFNESS,
-        damping=COUPLING_DAMPING,
+        stiffness=cfg.coupling_stiffness_n_per_m,
+        damping=cfg.coupling_damping_ns_per_m,
     )
     return Gripper(
         articulation=art,
         palm=links[PALM_NAME],
         fingers=(links["finger_left"], links["finger_right"]),
         joints=joints,
-        close_target_m=-max(CLOSE_PAST_M, CLOSE_FORCE_MARGIN * float(cfg.grip_force_n) / FINGER_STIFFNESS),
+        close_target_m=-max(
+            cfg.close_past_m, cfg.close_force_margin * float(cfg.grip_force_n) / cfg.finger_stiffness_n_per_m
+        ),
     )

@@ -4,10 +4,9 @@ import numpy as np
 from omegaconf import OmegaConf
 
 from graspexp.config.registry import job_config_from_yaml
-from graspexp.datasets import load_object
+from graspexp.datasets import job_object
 from graspexp.planning import plan
 from graspexp.quality import fc_min_mu
-from graspexp.seeding import derive_seed
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import NullRecorder, TrialContext, run_trial
 
@@ -38,7 +37,7 @@ def resimulate(log) -> tuple[bool, str]:
     cfg = job_config_from_yaml(meta["config_yaml"])
     plain = OmegaConf.to_object(cfg)
     name, trial, seed = meta["object"], int(meta["trial"]), int(meta["trial_seed"])
-    model = load_object(cfg.dataset, name, cfg.planner.n_points, derive_seed(cfg.seed, "cloud", name))
+    model = job_object(cfg, name)
     capture = _PoseCapture()
     result = run_trial(
         TrialContext(

@@ -28,11 +28,6 @@ from graspexp.sim.contacts import SupportTouch, contact_records, finger_forces
 from graspexp.sim.gripper import FINGER_NAMES, Gripper, build_gripper
 from graspexp.sim.scene import SUPPORT_NAME, TrialScene, build_scene
 
-FELL_BELOW_M = 0.05
-"""An object whose origin is this far below the support plane has fallen off it, m."""
-MIN_FINGER_FORCE_N = 0.5
-"""A finger holds the object when it presses with at least this force."""
-
 
 class TrialFailed(Exception):
     """Raised inside a trial at the first failed check; carries the reason."""
@@ -168,6 +163,7 @@ class _Sim:
         self.touch: SupportTouch | None = None
         self.touched_support = False
         self.max_speed_sq = float(cfg.sim.max_speed_mps) ** 2
+        self.max_angular_speed_sq = float(cfg.sim.max_angular_speed_radps) ** 2
         self.recording = recorder.active
         self._next_log = self.log_every if self.recording else -1
         self._physx_step = ts.scene.physx_system.step
@@ -198,7 +194,7 @@ class _Sim:
         linear, angular = self._velocities
         v, w = linear(), angular()
         vv, ww = self.speed_sq = v.dot(v), w.dot(w)
-        if not (vv <= self.max_speed_sq and ww < 1e12):  # NaN fails every comparison
+        if not (vv <= self.max_speed_sq and ww < self.max_angular_speed_sq):  # NaN fails every comparison
             raise TrialFailed(
                 FailureReason.SIM_UNSTABLE, f"object speed {float(vv) ** 0.5:.3g} m/s at t={self.t:.3f} s"
             )
@@ -251,7 +247,7 @@ def _settle(sim: _Sim) -> bool:
     cfg = sim.cfg.sim
     body = sim.ts.object_body
     min_steps = int(cfg.settle_min_s / sim.dt)
-    below_z = sim.ts.table_z - FELL_BELOW_M
+    below_z = sim.ts.table_z - cfg.fell_below_m
     linear_sq, angular_sq = cfg.settle_linear_mps**2, cfg.settle_angular_radps**2
     for _ in range(int(cfg.settle_max_s / sim.dt)):
         sim.step()
@@ -267,7 +263,8 @@ def _on_support(ts: TrialScene, cfg: JobConfig) -> bool:
     lo = ts.object_body.compute_global_aabb_tight()[0]
     com = (ts.object_entity.pose * ts.object_body.cmass_local_pose).p
     hx, hy = cfg.mode.support_half_size_m
-    return bool(lo[2] > ts.table_z - 0.01 and abs(com[0]) <= hx and abs(com[1]) <= hy)
+    tolerance = cfg.sim.on_support_tolerance_m
+    return bool(lo[2] > ts.table_z - tolerance and abs(com[0]) <= hx and abs(com[1]) <= hy)
 
 
 def _grasp_record(grasp: Grasp) -> dict:
@@ -415,7 +412,7 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
     gripper.close()
     sim.run(scfg.close_s)
     forces = _held(sim, grasp)
-    if min(forces.values()) < MIN_FINGER_FORCE_N:
+    if min(forces.values()) < ctx.cfg.sim.min_finger_force_n:
         res.finger_force_n = [forces[n] for n in FINGER_NAMES]
         raise TrialFailed(FailureReason.NO_CONTACT, f"finger forces after closing {forces} N")
 
@@ -440,7 +437,7 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
     forces = _held(sim, grasp)
     res.finger_force_n = [forces[n] for n in FINGER_NAMES]
     res.slip_m = float(np.linalg.norm(_grasp_point_on_object(gripper, ts) - grip0))
-    n_touching = sum(f >= MIN_FINGER_FORCE_N for f in forces.values())
+    n_touching = sum(f >= ctx.cfg.sim.min_finger_force_n for f in forces.values())
     if n_touching < len(forces):  # paper IV-C: success = the object is still held by the gripper
         raise TrialFailed(
             FailureReason.DROPPED,
