@@ -69,7 +69,7 @@ PLANNERS: tuple[Reading, ...] = (
     Reading("antipodal", ("planner=antipodal",), "GPD-style antipodal sampling, whole object"),
     Reading(
         "antipodal_area",
-        ("planner=antipodal", "planner.sample_area_only=true"),
+        ("planner=antipodal_area",),
         "antipodal sampling inside the grasping area",
     ),
     Reading("obb", ("planner=obb",), "top-down across the bounding box's short side"),

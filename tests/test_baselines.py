@@ -10,6 +10,7 @@ from test_planner_common import RG2  # explicit RG2 dimensions, independent of c
 from graspexp.cli import compose_config
 from graspexp.config.gripper import GripperGeometry
 from graspexp.planning import Grasp, NoFeasibleGrasp, PlanRequest, get_planner, plan
+from graspexp.planning.antipodal import antipodal_pairs
 from graspexp.planning.collision import cloud_hits, frame_from_axes, lowest_z
 
 MINE = ("antipodal", "obb", "random", "optimal_plus")
@@ -219,3 +220,17 @@ def test_every_planner_is_registered_and_composes() -> None:
     for name in MINE:
         assert get_planner(name).__name__.startswith("plan_")
         assert _cfg(name).planner.name == name
+
+
+def test_antipodal_area_keeps_both_contacts_in_the_area() -> None:
+    pts, normals = _cloud(_shapes()["box"], n=1500)
+    area = pts[:, 0] > 0.0  # half the box: a contact pair across x would leave it
+    mask = np.zeros(len(pts), bool)
+    mask[area] = True
+    seeds = np.flatnonzero(area)[:200]
+    free, _ = antipodal_pairs(pts, normals, seeds, 0.5, 0.1)
+    inside, _ = antipodal_pairs(pts, normals, seeds, 0.5, 0.1, partners=mask)
+    assert not mask[free[:, 1]].all()  # unrestricted partners leave the area
+    assert mask[inside].all() and len(inside) > 0
+    g = plan(_request("antipodal_area", pts, normals, area=mask)).grasp
+    assert g.planner == "antipodal_area"

@@ -4,7 +4,7 @@ Steps (cloud and normals in the world frame, metres; normals point outwards):
 
 1. seeds: ``planner.n_candidates`` cloud points drawn without replacement with
    ``np.random.default_rng(req.seed)``, from the whole cloud (GPD knows no grasping area) or, with
-   ``planner.sample_area_only``, from the area;
+   ``planner.sample_area_only``, from the area (and the partners of step 2 too: both contacts in the area);
 2. partner of each seed ``p1``: the cloud point ``p2`` that minimises the worse of the two cone angles
    ``a1 = angle(v, -n1)`` and ``a2 = angle(-v, -n2)`` (``v`` unit from ``p1`` to ``p2``), among partners
    with both angles ``<= atan(planner.friction_coef)`` and ``|p2 - p1| + 2 width_clearance_m`` within
@@ -53,10 +53,12 @@ def antipodal_pairs(
     seeds: np.ndarray,
     friction_coef: float,
     max_distance_m: float,
+    partners: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Best antipodal partner of each seed point (step 2 of the module doc).
 
-    points_m : (N, 3) world; normals : (N, 3) outward unit; seeds : (S,) indices into points.
+    points_m : (N, 3) world; normals : (N, 3) outward unit; seeds : (S,) indices into points;
+    partners : (N,) bool, the points a partner may be (None: all).
 
     Returns
     -------
@@ -69,6 +71,8 @@ def antipodal_pairs(
     )
     worst = np.minimum(cos1, cos2)
     valid = (d > 0) & (d <= max_distance_m) & (worst >= cone_cosine(friction_coef))
+    if partners is not None:
+        valid &= np.asarray(partners, dtype=bool)[None, :]
     worst = np.where(valid, worst, -np.inf)
     partner = np.argmax(worst, axis=1)
     keep = valid[np.arange(len(seeds)), partner]
@@ -117,7 +121,12 @@ def plan_antipodal(req: PlanRequest) -> PlanResult:
     rng = np.random.default_rng(req.seed)
     seeds = rng.choice(pool, size=min(int(pl.n_candidates), len(pool)), replace=False)
     pairs, angles = antipodal_pairs(
-        points, normals, seeds, pl.friction_coef, gr.max_width_m - 2.0 * pl.width_clearance_m
+        points,
+        normals,
+        seeds,
+        pl.friction_coef,
+        gr.max_width_m - 2.0 * pl.width_clearance_m,
+        req.area_mask if pl.sample_area_only else None,
     )
     if len(pairs) == 0:
         raise NoFeasibleGrasp(
@@ -164,7 +173,7 @@ def plan_antipodal(req: PlanRequest) -> PlanResult:
         cluster=-1,
         path=int(i),
         n_feasible=n_ok,
-        planner=NAME,
+        planner=req.planner.name,
         extras={
             "n_pairs": int(len(pairs)),
             "n_examined": int(examined),

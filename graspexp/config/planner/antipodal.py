@@ -16,7 +16,8 @@ class AntipodalConfig(OpeningConfig):
     friction_coef: float = 0.5
     """Friction coefficient mu of the sampling cone, half-angle atan(mu) (dimensionless)."""
     sample_area_only: bool = False
-    """Draw contacts from the grasping area only (False: from the whole cloud, as GPD)."""
+    """Both contacts from the grasping area (preset ``antipodal_area``: the fair comparison for planners that
+    must grasp the area); False: from the whole cloud, as GPD."""
     approach_tilt_weight: float = 0.1
     """Cost per degree between the approach and straight down, added to the contacts' worst
     friction-cone angle (degrees), so top-down approaches win among equally antipodal pairs."""
@@ -35,4 +36,4 @@ CONSTRAINTS = {
 PLUGIN = PlannerPlugin(
     plan="graspexp.planning.antipodal:plan_antipodal", config=AntipodalConfig, constraints=CONSTRAINTS
 )
-"""Entry point of the built-in planner (graspexp's ``pyproject.toml``)."""
+"""Entry point of ``antipodal`` and of ``antipodal_area`` (the same function, another preset)."""
