@@ -1,7 +1,8 @@
 """``python -m graspexp.readings [OUT] [--only a,b] [--trials N] [--datasets ycb,linemod] [--report-only]``.
 
 Runs every reading of the paper (:data:`READINGS`: the literal one, this project's default, and each
-single change from the default) and every other planner (:data:`PLANNERS`, for a ceiling) through the
+single change from the default), every other planner (:data:`PLANNERS`, for a ceiling) and
+``optimal_plus`` with each added term off on its own (:data:`ABLATIONS`) through the
 paper's four settings on Table 1 (YCB) and Table 2 (LINEMOD), each into its own sweep directory
 ``OUT/<name>/`` (default OUT: ``outputs/readings``), then writes the readings table
 (:mod:`graspexp.report.readings`) to ``OUT/readings.md`` / ``.csv`` and prints it. Every sweep is a
@@ -76,7 +77,53 @@ PLANNERS: tuple[Reading, ...] = (
 )
 """Other planners on the same drops: with the readings they give each object's best success (ceiling)."""
 
-ALL: dict[str, Reading] = {r.name: r for r in (*READINGS, *PLANNERS)}
+NOISE = ("perception.noise.trans_mm=3", "perception.noise.rot_deg=2")
+"""The pose noise the robustness rows add: 3 mm / 2 degrees std-dev, what optimal_plus assumes."""
+PLUS = ("planner=optimal_plus", "record=false")
+ABLATIONS: tuple[Reading, ...] = (
+    Reading(
+        "plus_opening_cluster", (*PLUS, "planner.opening=cluster"), "optimal_plus, opening >= 2 r_k (1.2)"
+    ),
+    Reading(
+        "plus_k_stroke", (*PLUS, "planner.cluster_length=stroke"), "optimal_plus, clusters one stroke long"
+    ),
+    Reading("plus_no_roll", (*PLUS, "planner.rolls_deg=[0.0]"), "optimal_plus, only the paper's roll"),
+    Reading(
+        "plus_no_depth_search",
+        (*PLUS, "planner.depth_offsets_m=[0.0]"),
+        "optimal_plus, grasp point at c_k depth",
+    ),
+    Reading(
+        "plus_min_depth_10mm", (*PLUS, "planner.min_pad_depth_m=0.01"), "optimal_plus, pad depth >= 10 mm"
+    ),
+    Reading(
+        "plus_no_min_depth",
+        (*PLUS, "planner.min_pad_depth_m=-0.5"),
+        "optimal_plus without the pad-depth test",
+    ),
+    Reading(
+        "plus_no_cone", (*PLUS, "planner.friction_coef=10"), "optimal_plus without the friction-cone test"
+    ),
+    Reading(
+        "plus_any_area",
+        (*PLUS, "planner.min_contacts_in_area=0"),
+        "optimal_plus, pads may touch outside the area",
+    ),
+    Reading("plus_no_com", (*PLUS, "planner.com_weight=0"), "optimal_plus without the gravity-arm factor"),
+    Reading(
+        "plus_no_noise_check", (*PLUS, "planner.noise_samples=0"), "optimal_plus without the pose-noise check"
+    ),
+    Reading("plus_noise", (*PLUS, *NOISE), "optimal_plus, perception noise 3 mm / 2 deg"),
+    Reading(
+        "plus_noise_no_check", (*PLUS, *NOISE, "planner.noise_samples=0"), "same noise, no pose-noise check"
+    ),
+    Reading(
+        "default_noise", ("planner=optimal", "record=false", *NOISE), "optimal, perception noise 3 mm / 2 deg"
+    ),
+)
+"""optimal_plus with each of its added terms switched off (or changed) on its own, and under pose noise."""
+
+ALL: dict[str, Reading] = {r.name: r for r in (*READINGS, *PLANNERS, *ABLATIONS)}
 
 
 def sweep_command(reading: Reading, out: Path, datasets: str, trials: int) -> list[str]:

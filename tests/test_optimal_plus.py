@@ -10,7 +10,6 @@ from test_baselines import TABLE_Z, _cfg, _cloud
 
 from graspexp.config.gripper import GripperGeometry
 from graspexp.planning import NoFeasibleGrasp, PlanRequest, plan
-from graspexp.planning.collision import local_coords
 from graspexp.planning.stability import gravity_arm_m, pad_contacts, pose_perturbations, volume_centroid_m
 
 
@@ -48,7 +47,7 @@ def test_pad_contacts_depth_and_cone_angle() -> None:
     box.apply_translation([0.0, 0.0, -0.03])  # faces at y = +-0.02, z from -0.045 to -0.015
     pts, faces = trimesh.sample.sample_surface_even(box, 3000, seed=2)
     normals = box.face_normals[faces]
-    depth, angle, _ = pad_contacts(local_coords(pts, frame), normals[None], geo, 0.002)
+    depth, angle, _ = pad_contacts(pts, normals, frame, geo, 0.002)
     assert depth[0] == pytest.approx(geo.tip_z_m + 0.03, abs=2e-3)  # the faces' middle, 3 cm behind the TCP
     assert angle[0] < np.radians(
         3
@@ -58,16 +57,14 @@ def test_pad_contacts_depth_and_cone_angle() -> None:
         0.0,
         geo.tip_z_m + 0.041,
     ]  # the faces now span z from tip - 4 mm to past the tips: an edge grasp
-    depth_tip, _, _ = pad_contacts(local_coords(shifted, frame), normals[None], geo, 0.002)
+    depth_tip, _, _ = pad_contacts(shifted, normals, frame, geo, 0.002)
     assert depth_tip[0] == pytest.approx(0.002, abs=0.0015)
     ball = trimesh.creation.icosphere(subdivisions=4, radius=0.1)
     pts, faces = trimesh.sample.sample_surface_even(ball, 20000, seed=3)
     cap = pts + [0.0, 0.0, geo.tip_z_m + 0.1 - 0.008]  # the pads reach 8 mm into a 0.2 m ball: its cap
-    _, cap_angle, _ = pad_contacts(local_coords(cap, frame), ball.face_normals[faces][None], geo, 0.002)
+    _, cap_angle, _ = pad_contacts(cap, ball.face_normals[faces], frame, geo, 0.002)
     assert np.degrees(cap_angle[0]) > 45  # the pads would press on the cap's slope, outside any cone
-    nothing, no_angle, _ = pad_contacts(
-        local_coords(pts + [1.0, 0, 0], frame), normals[:1][None] * 0 + 1, geo, 0.002
-    )
+    nothing, no_angle, _ = pad_contacts(pts + [1.0, 0, 0], normals, frame, geo, 0.002)
     assert nothing[0] == -np.inf and no_angle[0] == pytest.approx(np.pi)
 
 

@@ -27,10 +27,11 @@ import numpy as np
 
 from graspexp.config import GripperConfig
 from graspexp.config.gripper import GripperGeometry
+from graspexp.planning.kernels import swept_box_hits
 from graspexp.planning.pose import slab_spans_m
 
 POSE_BATCH = 128
-"""Poses per vectorised block in :func:`cloud_hits` (bounds memory at ~POSE_BATCH x N x 3 floats)."""
+"""Poses per block when :func:`place_grasps` centres grasps on their sections."""
 
 
 def lowest_z(poses: np.ndarray, gripper: GripperConfig, widths_m: np.ndarray, sweep_m: float) -> np.ndarray:
@@ -70,7 +71,8 @@ def cloud_hits(
     sweep_m: float,
     margin_m: float,
 ) -> np.ndarray:
-    """Number of cloud points inside the swept finger and palm boxes (module doc), per grasp.
+    """Number of cloud points inside the swept finger and palm boxes (module doc), per grasp. Compiled
+    (:func:`graspexp.planning.kernels.swept_box_hits`).
 
     points_m : (N, 3) world; poses : (B, 4, 4) world; widths_m : (B,) or scalar openings, m.
 
@@ -78,31 +80,22 @@ def cloud_hits(
     -------
     (B,) int64; 0 means collision-free.
     """
-    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)
+    poses = np.ascontiguousarray(np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4))
     widths = np.broadcast_to(np.asarray(widths_m, dtype=np.float64), (len(poses),))
-    out = np.zeros(len(poses), dtype=np.int64)
     geometry = GripperGeometry.of(gripper)
     fw, t = geometry.finger_width_m, geometry.finger_thickness_m
     px, py, pz = geometry.palm_size_m
     root, tip = geometry.root_z_m, geometry.tip_z_m
     m = margin_m
-    for s in range(0, len(poses), POSE_BATCH):
-        local = local_coords(points_m, poses[s : s + POSE_BATCH])
-        x, y, z = local[..., 0], local[..., 1], local[..., 2]
-        h = widths[s : s + POSE_BATCH, None] / 2
-        ay = np.abs(y)
-        fingers = (
-            (np.abs(x) <= fw / 2 + m)
-            & (z >= root - sweep_m - m)
-            & (z <= tip + m)
-            & (ay >= h - m)
-            & (ay <= h + t + m)
-        )
-        palm = (
-            (np.abs(x) <= px / 2 + m) & (ay <= py / 2 + m) & (z >= root - pz - sweep_m - m) & (z <= root + m)
-        )
-        out[s : s + POSE_BATCH] = (fingers | palm).sum(axis=1)
-    return out
+    finger = np.array([fw / 2 + m, t, root - sweep_m - m, tip + m, m])
+    palm = np.array([px / 2 + m, py / 2 + m, root - pz - sweep_m - m, root + m])
+    return swept_box_hits(
+        np.ascontiguousarray(points_m, dtype=np.float64),
+        poses,
+        np.ascontiguousarray(widths / 2),
+        finger,
+        palm,
+    )
 
 
 def support_lift_m(

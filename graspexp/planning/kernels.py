@@ -283,3 +283,101 @@ def slab_spans(
             out[b, 0] = lo
             out[b, 1] = hi
     return out
+
+
+@_jit
+def pad_contact_stats(
+    points: np.ndarray,
+    normals: np.ndarray,
+    area: np.ndarray,
+    poses: np.ndarray,
+    half_width: float,
+    z_lo: float,
+    z_hi: float,
+    band: float,
+) -> np.ndarray:
+    """Per grasp frame: [depth of the shallower pad's contact from ``z_hi``, larger contact-normal angle to
+    the closing axis (rad), smaller share of contact points in ``area``] (:func:`graspexp.planning.
+    stability.pad_contacts`). points, normals : (N, 3) world; area : (N,) bool; poses : (B, 4, 4).
+    Returns (B, 3) float64; a side without contact points gives -inf, pi and 0."""
+    n = points.shape[0]
+    out = np.empty((poses.shape[0], 3))
+    ys = np.empty(n)
+    zs = np.empty(n)
+    inside = np.zeros(n, dtype=np.bool_)
+    for b in range(poses.shape[0]):
+        r = poses[b]
+        lo, hi = np.inf, -np.inf
+        for i in range(n):
+            px, py, pz = points[i, 0] - r[0, 3], points[i, 1] - r[1, 3], points[i, 2] - r[2, 3]
+            x = r[0, 0] * px + r[1, 0] * py + r[2, 0] * pz
+            y = r[0, 1] * px + r[1, 1] * py + r[2, 1] * pz
+            z = r[0, 2] * px + r[1, 2] * py + r[2, 2] * pz
+            ok = abs(x) <= half_width and z >= z_lo and z <= z_hi
+            inside[i] = ok
+            ys[i] = y
+            zs[i] = z
+            if ok:
+                lo = min(lo, y)
+                hi = max(hi, y)
+        depth, angle, share = np.inf, 0.0, 1.0
+        for sign in (1.0, -1.0):
+            count, in_area, sum_z, ny = 0, 0, 0.0, 0.0
+            nx_, nz_ = 0.0, 0.0
+            for i in range(n):
+                if not inside[i]:
+                    continue
+                if (sign > 0 and ys[i] >= hi - band) or (sign < 0 and ys[i] <= lo + band):
+                    count += 1
+                    in_area += area[i]
+                    sum_z += zs[i]
+                    # the normal in the grasp frame: R^T n
+                    nx_ += r[0, 0] * normals[i, 0] + r[1, 0] * normals[i, 1] + r[2, 0] * normals[i, 2]
+                    ny += r[0, 1] * normals[i, 0] + r[1, 1] * normals[i, 1] + r[2, 1] * normals[i, 2]
+                    nz_ += r[0, 2] * normals[i, 0] + r[1, 2] * normals[i, 1] + r[2, 2] * normals[i, 2]
+            if count == 0:
+                depth, angle, share = -np.inf, np.pi, 0.0
+                continue
+            depth = min(depth, z_hi - sum_z / count)
+            length = np.sqrt(nx_ * nx_ + ny * ny + nz_ * nz_)
+            a = np.pi if length == 0 else np.arccos(min(max(sign * ny / length, -1.0), 1.0))
+            angle = max(angle, a)
+            share = min(share, in_area / count)
+        out[b, 0] = depth
+        out[b, 1] = angle
+        out[b, 2] = share
+    return out
+
+
+@_jit
+def swept_box_hits(
+    points: np.ndarray,
+    poses: np.ndarray,
+    half_widths: np.ndarray,
+    finger: np.ndarray,
+    palm: np.ndarray,
+) -> np.ndarray:
+    """Points inside the swept finger and palm boxes of each grasp (:func:`graspexp.planning.collision.
+    cloud_hits`). points : (N, 3) world; poses : (B, 4, 4); half_widths : (B,) half openings, m;
+    finger : [half x, thickness, z lo, z hi, margin]; palm : [half x, half y, z lo, z hi], margin included
+    except in ``finger``'s y bounds. Returns (B,) int64."""
+    out = np.zeros(poses.shape[0], dtype=np.int64)
+    fx, ft, fz0, fz1, m = finger[0], finger[1], finger[2], finger[3], finger[4]
+    px, py, pz0, pz1 = palm[0], palm[1], palm[2], palm[3]
+    for b in range(poses.shape[0]):
+        r = poses[b]
+        h = half_widths[b]
+        count = 0
+        for i in range(points.shape[0]):
+            qx, qy, qz = points[i, 0] - r[0, 3], points[i, 1] - r[1, 3], points[i, 2] - r[2, 3]
+            z = r[0, 2] * qx + r[1, 2] * qy + r[2, 2] * qz
+            if z > fz1 and z > pz1:
+                continue
+            x = abs(r[0, 0] * qx + r[1, 0] * qy + r[2, 0] * qz)
+            y = abs(r[0, 1] * qx + r[1, 1] * qy + r[2, 1] * qz)
+            in_finger = x <= fx and fz0 <= z <= fz1 and h - m <= y <= h + ft + m
+            in_palm = x <= px and y <= py and pz0 <= z <= pz1
+            if in_finger or in_palm:
+                count += 1
+        out[b] = count
+    return out

@@ -40,7 +40,7 @@ paper's, inf where removed by the plane test), ``best``, ``pose``, ``width``) pl
 import numpy as np
 
 from graspexp.config.gripper import GripperGeometry
-from graspexp.planning.collision import cloud_hits, local_coords, place_for_request
+from graspexp.planning.collision import cloud_hits, place_for_request
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.optimal import paper_candidates
 from graspexp.planning.pose import grasp_rotations, opening_widths_m
@@ -200,10 +200,7 @@ def _pads_hold(
     """Step 3 of the module doc for (B, 4, 4) poses: (B,) whether both pads' contacts are at least
     ``min_pad_depth_m`` deep, inside the friction cone of ``friction_coef`` and at least
     ``min_contacts_in_area`` in the grasping area, and (B,) the depth, m."""
-    local_normals = normals[None] @ poses[:, :3, :3]
-    depth, angle, share = pad_contacts(
-        local_coords(points, poses), local_normals, geometry, pl.contact_band_m, area_mask
-    )
+    depth, angle, share = pad_contacts(points, normals, poses, geometry, pl.contact_band_m, area_mask)
     ok = (depth >= pl.min_pad_depth_m) & (angle <= np.arctan(pl.friction_coef))
     return ok & (share >= pl.min_contacts_in_area), depth
 

@@ -25,6 +25,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 from graspexp.config.gripper import GripperGeometry
 from graspexp.geometry import axis_angle_matrix
+from graspexp.planning.kernels import pad_contact_stats
 
 
 def volume_centroid_m(points_m: np.ndarray) -> np.ndarray:
@@ -55,8 +56,9 @@ def gravity_arm_m(poses: np.ndarray, com_m: np.ndarray) -> np.ndarray:
 
 
 def pad_contacts(
-    local: np.ndarray,
-    local_normals: np.ndarray,
+    points_m: np.ndarray,
+    normals: np.ndarray,
+    poses: np.ndarray,
     geometry: GripperGeometry,
     band_m: float,
     area_mask: np.ndarray | None = None,
@@ -65,36 +67,29 @@ def pad_contacts(
     between the contact normal and the closing axis, rad (module doc), and the smaller of the two sides'
     shares of contact points in the grasping area, per grasp.
 
-    local : (B, N, 3) cloud points in each grasp frame; local_normals : (B, N, 3) their outward unit
-    normals in the same frames; area_mask : (N,) bool grasping area (None: all points). A side's normal
-    is the mean of its contact points' normals; the left pad (+Y side) presses against a surface facing
-    +Y. Where a side has no contact point: depth -inf, angle pi and share 0.
+    points_m : (N, 3) world cloud; normals : (N, 3) its outward unit normals; poses : (B, 4, 4) world grasp
+    frames; area_mask : (N,) bool grasping area (None: all points). A side's normal is the mean of its
+    contact points' normals; the left pad (+Y side) presses against a surface facing +Y. Where a side has
+    no contact point: depth -inf, angle pi and share 0. Compiled
+    (:func:`graspexp.planning.kernels.pad_contact_stats`): numpy's (B, N) passes were most of a plan.
 
     Returns
     -------
     depth_m, angle_rad, in_area : (B,) float64.
     """
-    x, y, z = local[..., 0], local[..., 1], local[..., 2]
-    reach = (np.abs(x) <= geometry.finger_width_m / 2) & (z >= geometry.root_z_m) & (z <= geometry.tip_z_m)
-    hi = np.where(reach, y, -np.inf).max(axis=1, keepdims=True)
-    lo = np.where(reach, y, np.inf).min(axis=1, keepdims=True)
-    depth = np.full(len(local), np.inf)
-    angle = np.zeros(len(local))
-    share = np.ones(len(local))
-    inside = np.ones(local.shape[1], dtype=bool) if area_mask is None else np.asarray(area_mask, dtype=bool)
-    for sign, side in ((1.0, reach & (y >= hi - band_m)), (-1.0, reach & (y <= lo + band_m))):
-        n = side.sum(axis=1)
-        some = n > 0
-        with np.errstate(invalid="ignore", divide="ignore"):
-            mean_z = np.where(side, z, 0.0).sum(axis=1) / n
-        depth = np.minimum(depth, np.where(some, geometry.tip_z_m - mean_z, -np.inf))
-        normal = np.where(side[..., None], local_normals, 0.0).sum(axis=1)  # (B, 3)
-        length = np.linalg.norm(normal, axis=1)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            cos = np.clip(sign * normal[:, 1] / length, -1.0, 1.0)
-        angle = np.maximum(angle, np.where(some & (length > 0), np.arccos(cos), np.pi))
-        share = np.minimum(share, np.where(some, (side & inside).sum(axis=1) / np.maximum(n, 1), 0.0))
-    return depth, angle, share
+    p = np.ascontiguousarray(points_m, dtype=np.float64)
+    area = np.ones(len(p), dtype=bool) if area_mask is None else np.asarray(area_mask, dtype=bool)
+    stats = pad_contact_stats(
+        p,
+        np.ascontiguousarray(normals, dtype=np.float64),
+        np.ascontiguousarray(area),
+        np.ascontiguousarray(np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)),
+        geometry.finger_width_m / 2,
+        geometry.root_z_m,
+        geometry.tip_z_m,
+        band_m,
+    )
+    return stats[:, 0], stats[:, 1], stats[:, 2]
 
 
 def pose_perturbations(
