@@ -42,7 +42,7 @@ from graspexp.compare.report import success_by_noise as noise_success_table
 from graspexp.config import ConfigError, PluginError, validate
 from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
 from graspexp.report.collect import collect
-from graspexp.report.contact_area import finger_contacts_in_area
+from graspexp.report.contact_area import IN_AREA_TOLERANCE_M, finger_contacts_in_area
 from graspexp.report.paper import PAPER_TABLES, SETTINGS, TRIALS_PER_SETTING
 from graspexp.report.render import display_frame, footnotes, markdown
 from graspexp.report.stats import percentiles, wilson_interval
@@ -51,9 +51,10 @@ from graspexp.report.tables import failure_breakdown, success_table
 NOISE_LEVELS: tuple[tuple[float, float], ...] = ((10.0, 0.0), (20.0, 0.0), (0.0, 10.0))
 """Pose-noise levels (translation std mm, rotation std degrees) run besides zero, as in ``nox -s compare``."""
 IN_AREA_NOTE = (
-    "In-area contact %: share of the finger-object contacts at the end of closing whose nearest point of "
-    "the object's cloud is a grasping-area point (graspexp/report/contact_area.py; from each log's "
-    "/contacts and /tf), over the trials whose fingers touch the object then."
+    "In-area contact %: share of the finger-object contacts at the end of closing that lie within "
+    f"{IN_AREA_TOLERANCE_M * 1000:g} mm of a grasping-area point of the object's cloud "
+    "(graspexp/report/contact_area.py; from each log's /contacts and /tf), over the trials whose fingers "
+    "touch the object then."
 )
 
 

@@ -89,16 +89,24 @@ class Names:
 
 @dataclass(frozen=True)
 class Vector:
-    """A list of ``length`` values, each accepted by ``item``."""
+    """A list of ``length`` values (None: one or more), each accepted by ``item``."""
 
-    length: int
+    length: int | None
     item: Interval
 
     def accepts(self, v: object) -> bool:
-        return isinstance(v, list | tuple) and len(v) == self.length and all(self.item.accepts(x) for x in v)
+        n_ok = (
+            len(v) == self.length
+            if self.length is not None
+            else len(v) > 0
+            if isinstance(v, list | tuple)
+            else False
+        )
+        return isinstance(v, list | tuple) and n_ok and all(self.item.accepts(x) for x in v)
 
     def __str__(self) -> str:
-        return f"a list of {self.length} values, each {self.item}"
+        n = "one or more" if self.length is None else f"{self.length}"
+        return f"a list of {n} values, each {self.item}"
 
 
 BOOL = [Options((True, False))]

@@ -27,6 +27,7 @@ import numpy as np
 
 from graspexp.config import GripperConfig
 from graspexp.config.gripper import GripperGeometry
+from graspexp.planning.pose import slab_spans_m
 
 POSE_BATCH = 128
 """Poses per vectorised block in :func:`cloud_hits` (bounds memory at ~POSE_BATCH x N x 3 floats)."""
@@ -36,6 +37,9 @@ def lowest_z(poses: np.ndarray, gripper: GripperConfig, widths_m: np.ndarray, sw
     """Lowest world z reached by any gripper box during the approach, for a batch of grasps.
 
     poses : (B, 4, 4) grasp poses, world; widths_m : (B,) openings, m; sweep_m : approach length, m.
+    A box swept ``sweep_m`` back along -Z is the box with its z range grown by ``sweep_m`` towards -Z; the
+    lowest world z of an axis-aligned box ``[lo, hi]`` under rotation R is ``t_z + sum_a min(R[2, a] lo_a,
+    R[2, a] hi_a)``.
 
     Returns
     -------
@@ -43,46 +47,18 @@ def lowest_z(poses: np.ndarray, gripper: GripperConfig, widths_m: np.ndarray, sw
     """
     poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)
     widths = np.broadcast_to(np.asarray(widths_m, dtype=np.float64), (len(poses),))
-    out = np.empty(len(poses))
-    pick = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])  # 8 corners: lo/hi per axis
-    back = np.array([0.0, 0.0, sweep_m])
-    geometry = GripperGeometry.of(gripper)
-    for b, (pose, w) in enumerate(zip(poses, widths, strict=True)):
-        boxes = geometry.boxes(float(w))  # (3, 2, 3)
-        corners = boxes[:, pick, np.arange(3)].reshape(-1, 3)  # (24, 3) grasp frame
-        ends = np.concatenate([corners, corners - back])  # grasp and pre-grasp ends of the approach
-        out[b] = float((ends @ pose[:3, :3].T + pose[:3, 3])[:, 2].min())
-    return out
+    boxes = GripperGeometry.of(gripper).boxes_batch(widths)  # (B, 3, 2, 3)
+    boxes[:, :, 0, 2] -= sweep_m
+    r = poses[:, 2, :3][:, None, None, :]  # (B, 1, 1, 3): row z of each rotation
+    reach = (r * boxes).min(axis=2).sum(axis=-1)  # (B, 3) per box
+    return poses[:, 2, 3] + reach.min(axis=1)
 
 
 def local_coords(points_m: np.ndarray, poses: np.ndarray) -> np.ndarray:
     """(B, N, 3) coordinates of world points (N, 3) in each grasp frame of (B, 4, 4) poses."""
     p = np.asarray(points_m, dtype=np.float64)
     poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)
-    rel = p[None, :, :] - poses[:, None, :3, 3]
-    return np.einsum("bni,bij->bnj", rel, poses[:, :3, :3])
-
-
-def closing_section(
-    local: np.ndarray, gripper: GripperConfig, margin_m: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Range of ``y`` over the points in the pads' reach: what the fingers must close around.
-
-    local : (B, N, 3) points in each grasp frame. A point is in reach when ``|x| <= fw/2 + margin`` and
-    ``z`` lies within the finger span (module doc) grown by ``margin``.
-
-    Returns
-    -------
-    lo, hi : (B,) float64, metres; both 0 where no point is in reach.
-    """
-    geometry = GripperGeometry.of(gripper)
-    fw, root, tip = geometry.finger_width_m, geometry.root_z_m, geometry.tip_z_m
-    x, y, z = local[..., 0], local[..., 1], local[..., 2]
-    reach = (np.abs(x) <= fw / 2 + margin_m) & (z >= root - margin_m) & (z <= tip + margin_m)
-    hi = np.where(reach, y, -np.inf).max(axis=1)
-    lo = np.where(reach, y, np.inf).min(axis=1)
-    some = reach.any(axis=1)
-    return np.where(some, lo, 0.0), np.where(some, hi, 0.0)
+    return (p[None, :, :] - poses[:, None, :3, 3]) @ poses[:, :3, :3]
 
 
 def cloud_hits(
@@ -217,7 +193,7 @@ def place_grasps(
     """Open, lift and check a batch of candidate grasps against the cloud and the support.
 
     1. centre: each grasp point moves along +Y to the middle of the object's section between the pads
-       (:func:`closing_section`; the pads close symmetrically about the grasp point, so an off-centre
+       (:func:`graspexp.planning.pose.slab_spans_m`, grown by ``margin_m``; the pads close symmetrically about the grasp point, so an off-centre
        point would need a needlessly wide opening); opening = ``max(min_widths_m, section + 2
        clearance_m)``, at least ``gripper.min_width_m``;
     2. move the grasp back along -Z by :func:`support_lift_m` (at most ``max_lift_m``, else rejected as
@@ -236,9 +212,9 @@ def place_grasps(
         out = np.empty(len(ps))
         for s in range(0, len(ps), POSE_BATCH):
             blk = ps[s : s + POSE_BATCH]
-            lo, hi = closing_section(local_coords(points_m, blk), gripper, margin_m)
-            blk[:, :3, 3] += ((lo + hi) / 2)[:, None] * blk[:, :3, 1]
-            out[s : s + POSE_BATCH] = hi - lo
+            spans = slab_spans_m(points_m, blk[:, :3, 3], blk[:, :3, :3], gripper, margin_m)
+            blk[:, :3, 3] += spans.mean(axis=1)[:, None] * blk[:, :3, 1]
+            out[s : s + POSE_BATCH] = spans[:, 1] - spans[:, 0]
         return np.maximum(out + 2.0 * clearance_m, fl)
 
     widths = centre_and_open(poses, floor)
@@ -292,14 +268,15 @@ def max_lift_m(gripper: GripperConfig) -> float:
 
 def place_for_request(req, poses: np.ndarray, min_widths_m: np.ndarray | float = 0.0) -> Placement:
     """:func:`place_grasps` with the request's cloud, support plane, gripper and planner settings
-    (sweep = ``planner.sphere_radius_m``, ``collision_margin_m``, ``width_clearance_m``)."""
+    (sweep = ``planner.sphere_radius_m``, ``collision_margin_m``, ``width_clearance_m``). A support that
+    does not block the gripper (``req.support_blocks_gripper`` False) is not checked."""
     pl, gr = req.planner, req.gripper
     return place_grasps(
         np.asarray(req.points, dtype=np.float64),
         poses,
         gr,
         sweep_m=pl.sphere_radius_m,
-        table_z=req.table_z,
+        table_z=req.table_z if req.support_blocks_gripper else -np.inf,
         margin_m=pl.collision_margin_m,
         clearance_m=pl.width_clearance_m,
         max_lift_m=max_lift_m(gr),

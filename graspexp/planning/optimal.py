@@ -87,10 +87,11 @@ class Candidates:
     costs: np.ndarray
 
 
-def paper_candidates(req: PlanRequest, planner: str) -> Candidates:
+def paper_candidates(req: PlanRequest, planner: str, cluster_length_m: float | None = None) -> Candidates:
     """Grasping area -> main axis -> K-means -> Fibonacci paths -> support test -> cost, as in section III.
 
-    ``planner`` names the caller in error messages. Raises NoFeasibleGrasp for an empty area or when every
+    ``planner`` names the caller in error messages. ``cluster_length_m``: the length along the main axis
+    that ``k: auto`` gives each cluster, m (None: ``planner.auto_k_stroke_fraction`` of the stroke). Raises NoFeasibleGrasp for an empty area or when every
     path starts below the support plane; ValueError for malformed inputs.
     """
     points = np.asarray(req.points, dtype=np.float64)
@@ -108,7 +109,10 @@ def paper_candidates(req: PlanRequest, planner: str) -> Candidates:
     pl, gr = req.planner, req.gripper
     axes = {name: main_axis(points if name == "object" else area) for name in {pl.main_axis, pl.pose_axis}}
     axis = axes[pl.main_axis]
-    k = choose_k(pl.k, pl.k_max, area, axis, gr.max_width_m, pl.auto_k_stroke_fraction)
+    if cluster_length_m is None:
+        k = choose_k(pl.k, pl.k_max, area, axis, gr.max_width_m, pl.auto_k_stroke_fraction)
+    else:
+        k = choose_k(pl.k, pl.k_max, area, axis, cluster_length_m, 1.0)
     clusters = segment(area, k, random_state=kmeans_random_state(req.seed, pl.seed))
     if pl.cluster_radius == "max":
         clusters = replace(clusters, radii_m=max_radii_m(area, clusters))

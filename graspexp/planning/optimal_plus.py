@@ -1,123 +1,175 @@
-"""``optimal_plus``: the paper's planner (:mod:`.optimal`) with three general weaknesses fixed.
+"""``optimal_plus``: the paper's candidates and cost, then the tests a grasp needs to hold in physics.
 
-Same grasping area, main axis, K-means clusters, Fibonacci-sphere paths, support-plane test and cost
-Eq. (1)-(3) as ``optimal`` (its building blocks are reused unchanged). Then:
+The paper's steps are reused unchanged (:func:`graspexp.planning.optimal.paper_candidates`): grasping
+area, main axis, K-means clusters, M Fibonacci-sphere paths per cluster, support-plane test and cost
+Eq. (1)-(3). Its paths are then examined in ascending cost, in batches of :data:`PATH_BATCH`; each path
+is tried at several depths along its approach, and every try is checked as follows (each term has a
+``planner`` key, graspexp/config/planner/optimal_plus.py):
 
-1. **Centre-of-mass preference.** Each cluster's costs are multiplied by
-   ``1 + planner.com_weight * |c_k - g| / D``, where ``g`` is the centroid of the cloud (the centre of
-   mass of a uniform shell, the best estimate a surface cloud gives) and ``D`` the diagonal of the
-   cloud's axis-aligned box, m/m. A grasp near the centre of mass resists the gravity torque that
-   makes off-centre grasps rotate and slip once the support goes (collab) or during the lift (bin).
-2. **Opening from the geometry, not only from r_k.** The grasp point slides along the closing axis
-   to the middle of the object's section between the pads (the cloud points within the finger width
-   and span), and the opening is ``max(2 r_k (1 + width_margin), section + 2 width_clearance_m)``:
-   ``2 r_k`` under-estimates the section of round or elongated clusters, and the pads close
-   symmetrically about the grasp point, so the paper's opening about an off-centre cluster centre can
-   land a finger on the object. Above the stroke, the path is rejected.
-3. **Swept-volume collision check.** Each path is checked, in ascending cost, with the finger and palm
-   boxes swept along the straight approach against the cloud and against the support plane
-   (:func:`graspexp.planning.collision.place_for_request`; a grasp whose boxes would dip below the plane is
-   first moved back along the approach, by at most 80 % of the fingertip reach). The paper only tests
-   the path's start point against the plane, so the palm can hit the object (e.g. a tall object
-   grasped low from above) and the fingertips the table.
+1. **Opening and grasp point from the geometry** (``opening``). The grasp point moves along the closing
+   axis to the middle of the object's section between the pads and the opening is that section plus
+   ``2 width_clearance_m`` (``section``), or at least the paper's ``2 r_k (1 + width_margin)``
+   (``cluster``). Wider than the stroke: rejected.
+2. **Swept-volume collision** of both fingers and the palm with the cloud and the support along the whole
+   straight approach (:func:`graspexp.planning.collision.place_grasps`, margin ``collision_margin_m``).
+3. **Pad contacts** (``depth_offsets_m``, ``rolls_deg``, ``min_pad_depth_m``, ``pad_depth_target_m``,
+   ``friction_coef``, ``min_contacts_in_area``): the grasp frame is rolled about the approach by each of ``rolls_deg`` and its
+   point moved along the approach by each offset; a try is kept only when both pads' contacts are
+   centred at least ``min_pad_depth_m`` behind the fingertips, their surface normals lie inside the
+   friction cone about the closing axis and at least ``min_contacts_in_area`` of each pad's contact
+   points are grasping-area points (:func:`graspexp.planning.stability.pad_contacts`). Per path the
+   first roll with a passing try is taken, and in it the try whose shallower pad depth reaches
+   ``pad_depth_target_m`` with the smallest move (else the deepest).
+4. **Gravity arm** (``com_weight``): the path's cost is multiplied by ``1 + com_weight * a / D``, with
+   ``a`` the arm of gravity about the closing axis (:func:`graspexp.planning.stability.gravity_arm_m`;
+   centre of mass = the cloud's solid-hull centroid) and ``D`` the diagonal of the cloud's box.
+5. **Pose noise** (``noise_trans_mm``, ``noise_rot_deg``, ``noise_samples``, ``noise_min_pass``): the
+   first ``shortlist`` passing paths are re-checked (collision with zero margin and pad depth) with the
+   cloud moved by ``noise_samples`` motions drawn from the estimator's error about the object's
+   origin; the paths passing in at least ``noise_min_pass`` of them (else those passing most often)
+   compete on the cost of 4.
 
-The cheapest path that passes wins. ``Grasp.n_feasible`` counts the passing paths among those examined
-(examination stops at the first pass after a batch). ``details`` holds the same keys as ``optimal``
-where they apply (``cloud``, ``area_mask``, ``labels``, ``centers``, ``radii``, ``main_axis``,
-``directions``, ``costs`` (K, M; inf where removed by the plane test), ``best``, ``pose``, ``width``)
-plus ``com`` (3,) and ``com_factor`` (K,).
+Examination stops once ``shortlist`` paths pass 1-3. ``Grasp.n_feasible`` counts them; ``extras`` holds
+``K``, ``M``, ``n_examined``, the rejections (``n_too_wide``, ``n_below_support``, ``n_collides``,
+``n_weak_contact``), ``pad_depth_m``, ``gravity_arm_m``, ``depth_offset_m``, ``noise_pass`` and
+``com_factor``. ``details`` holds the same keys as ``optimal`` where they apply (``cloud``,
+``area_mask``, ``labels``, ``centers``, ``radii``, ``main_axis``, ``directions``, ``costs`` (K, M; the
+paper's, inf where removed by the plane test), ``best``, ``pose``, ``width``) plus ``com`` (3,).
 """
 
 import numpy as np
 
-from graspexp.planning.collision import place_for_request
+from graspexp.config.gripper import GripperGeometry
+from graspexp.planning.collision import cloud_hits, local_coords, place_for_request
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.optimal import paper_candidates
 from graspexp.planning.pose import grasp_rotations, opening_widths_m
 from graspexp.planning.request import PlanRequest, PlanResult
+from graspexp.planning.stability import gravity_arm_m, pad_contacts, pose_perturbations, volume_centroid_m
+from graspexp.seeding import rng_for
 
 NAME = "optimal_plus"
 
-PATH_BATCH = 32
-"""Paths checked together, in ascending cost."""
+PATH_BATCH = 16
+"""Paths examined together, in ascending paper cost."""
 
 
-def com_factors(
-    centers_m: np.ndarray, points_m: np.ndarray, com_weight: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Cost factors ``1 + w |c_k - g| / D`` (fix 1 of the module doc) and the centroid ``g`` (3,)."""
-    g = points_m.mean(axis=0)
-    size = float(np.linalg.norm(points_m.max(axis=0) - points_m.min(axis=0)))
-    dist = np.linalg.norm(centers_m - g, axis=1)
-    return 1.0 + com_weight * dist / max(size, 1e-9), g
+def _check_params(pl) -> None:
+    if pl.com_weight < 0:
+        raise ValueError(f"planner.com_weight={pl.com_weight!r} is invalid: expected a non-negative number")
+    for key, example in (("depth_offsets_m", "[0.0]"), ("rolls_deg", "[0.0]")):
+        if not getattr(pl, key):
+            raise ValueError(f"planner.{key} is empty: give at least one value, e.g. {example}")
 
 
 def plan_optimal_plus(req: PlanRequest) -> PlanResult:
-    """Plan one grasp with the paper's strategy plus the fixes of the module doc.
+    """Plan one grasp with the paper's candidates and the checks of the module doc.
 
     Raises
     ------
     NoFeasibleGrasp
-        Empty grasping area; every path crosses the support plane; or every remaining path is too wide,
-        below the support or colliding with the cloud.
+        Empty grasping area; every path crosses the support plane; or no path passes checks 1-3.
     """
     pl, gr = req.planner, req.gripper
-    if pl.com_weight < 0:
-        raise ValueError(f"planner.com_weight={pl.com_weight!r} is invalid: expected a non-negative number")
-    cand = paper_candidates(req, NAME)
-    points, axis, directions, feasible = cand.points, cand.axis, cand.directions, cand.feasible
-    centers, radii = cand.clusters.centers_m, cand.clusters.radii_m
+    _check_params(pl)
+    geometry = GripperGeometry.of(gr)
+    length = geometry.finger_width_m if pl.cluster_length == "finger_width" else None
+    cand = paper_candidates(req, NAME, cluster_length_m=length)
+    points, directions, centers = cand.points, cand.directions, cand.clusters.centers_m
+    normals = np.asarray(req.normals, dtype=np.float64)
     k, m = cand.costs.shape
-    factors, com = com_factors(centers, points, pl.com_weight)
-    costs = factors[:, None] * cand.costs
-    openings = opening_widths_m(radii, pl.width_margin, gr)
+    com = volume_centroid_m(points)
+    size = max(float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))), 1e-9)
+    floors = opening_widths_m(cand.clusters.radii_m, pl.width_margin, gr)  # (K,) m, the paper's 2 r_k rule
+    if pl.opening == "section":
+        floors = np.zeros(k)
+    offsets = np.asarray(pl.depth_offsets_m, dtype=np.float64)
+    rolls = [_roll(np.deg2rad(r)) for r in pl.rolls_deg]
+    n_roll, n_off = len(rolls), len(offsets)
+    by_offset = np.argsort(np.abs(offsets), kind="stable")  # tie-break: the smallest move
 
-    order = np.argsort(costs, axis=None, kind="stable")[: int(feasible.sum())]
-    rejected = {"n_too_wide": 0, "n_below_support": 0, "n_collides": 0}
-    best = None
-    n_ok = examined = 0
+    order = np.argsort(cand.costs, axis=None, kind="stable")[: int(cand.feasible.sum())]
+    rejected = {"n_too_wide": 0, "n_below_support": 0, "n_collides": 0, "n_weak_contact": 0}
+    passed: list[tuple] = []  # (k, p, pose, width, depth, offset, roll_deg)
+    examined = 0
     for s in range(0, len(order), PATH_BATCH):
         ks, ps = np.unravel_index(order[s : s + PATH_BATCH], (k, m))
-        poses = np.tile(np.eye(4), (len(ks), 1, 1))
-        poses[:, :3, :3] = grasp_rotations(directions[ks, ps], cand.pose_axis)
-        poses[:, :3, 3] = centers[ks]
-        placed = place_for_request(req, poses, min_widths_m=openings[ks])
         examined += len(ks)
+        b = len(ks)
+        rots = grasp_rotations(directions[ks, ps], cand.pose_axis)  # (B, 3, 3)
+        poses = np.tile(np.eye(4), (b, n_roll, n_off, 1, 1))
+        for r, roll in enumerate(rolls):
+            poses[:, r, :, :3, :3] = (rots @ roll)[:, None]
+        poses[..., :3, 3] = (
+            centers[ks][:, None, None] + offsets[None, None, :, None] * rots[:, None, None, :, 2]
+        )
+        placed = place_for_request(req, poses.reshape(-1, 4, 4), np.repeat(floors[ks], n_roll * n_off))
+        depth = np.full(len(placed.ok), -np.inf)
+        held = np.zeros(len(placed.ok), dtype=bool)
+        if placed.ok.any():
+            held[placed.ok], depth[placed.ok] = _pads_hold(
+                pl, geometry, points, normals, cand.area_mask, placed.poses[placed.ok]
+            )
+        ok = placed.ok & held
         for key, n in placed.counts().items():
             rejected[key] += n
-        n_ok += int(placed.ok.sum())
-        if placed.ok.any():
-            j = int(np.argmax(placed.ok))  # the batch is in ascending cost
-            best = (
-                int(ks[j]),
-                int(ps[j]),
-                placed.poses[j],
-                float(placed.widths_m[j]),
-                float(placed.lift_m[j]),
+        rejected["n_weak_contact"] += int((placed.ok & ~ok).sum())
+        ok, depth = ok.reshape(b, n_roll, n_off), depth.reshape(b, n_roll, n_off)
+        # per path: the first roll with a passing try, then the target depth with the smallest move
+        for i in np.flatnonzero(ok.any(axis=(1, 2))):
+            r = int(np.argmax(ok[i].any(axis=1)))
+            score = np.where(ok[i, r], np.minimum(depth[i, r], pl.pad_depth_target_m), -np.inf)
+            j = int(by_offset[int(np.argmax(score[by_offset]))])
+            f = (i * n_roll + r) * n_off + j
+            passed.append(
+                (
+                    int(ks[i]),
+                    int(ps[i]),
+                    placed.poses[f],
+                    float(placed.widths_m[f]),
+                    float(depth[i, r, j]),
+                    float(offsets[j]),
+                    float(pl.rolls_deg[r]),
+                )
             )
+        if len(passed) >= pl.shortlist:
             break
-    if best is None:
+    if not passed:
         raise NoFeasibleGrasp(
-            f"optimal_plus: all {examined} paths above the support failed: {rejected['n_too_wide']} too "
-            f"wide for the stroke {gr.max_width_m} m, {rejected['n_below_support']} below the support, "
-            f"{rejected['n_collides']} with fingers or palm colliding with the cloud"
+            f"optimal_plus: all {examined} paths above the support failed at every depth: "
+            f"{rejected['n_too_wide']} tries too wide for the stroke {gr.max_width_m} m, "
+            f"{rejected['n_below_support']} below the support, {rejected['n_collides']} colliding with the "
+            f"cloud, {rejected['n_weak_contact']} with a pad contact shallower than {pl.min_pad_depth_m} m, outside the friction cone or outside the grasping area"
         )
-    kb, pb, pose, width, lift = best
+    passed = passed[: pl.shortlist]
+    poses = np.stack([p[2] for p in passed])
+    widths = np.array([p[3] for p in passed])
+    arms = gravity_arm_m(poses, com)
+    factors = 1.0 + pl.com_weight * arms / size
+    costs = np.array([cand.costs[p[0], p[1]] for p in passed]) * factors
+    noise_pass = _noise_pass(req, points, poses, widths, geometry)
+    robust = noise_pass >= min(pl.noise_min_pass, noise_pass.max())
+    j = int(np.argmin(np.where(robust, costs, np.inf)))
+    kb, pb, pose, width, depth, offset, roll_deg = passed[j]
     grasp = Grasp(
         pose=pose,
         width_m=width,
-        cost=float(costs[kb, pb]),
+        cost=float(costs[j]),
         cluster=kb,
         path=pb,
-        n_feasible=n_ok,
+        n_feasible=len(passed),
         planner=NAME,
         extras={
             "K": k,
             "M": m,
             "n_examined": examined,
-            "lift_m": lift,
-            "com_factor": float(factors[kb]),
             **rejected,
+            "pad_depth_m": depth,
+            "depth_offset_m": offset,
+            "roll_deg": roll_deg,
+            "gravity_arm_m": float(arms[j]),
+            "com_factor": float(factors[j]),
+            "noise_pass": float(noise_pass[j]),
         },
     )
     details = {
@@ -125,14 +177,61 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
         "area_mask": cand.area_mask,
         "labels": cand.clusters.labels,
         "centers": centers,
-        "radii": radii,
-        "main_axis": axis,
+        "radii": cand.clusters.radii_m,
+        "main_axis": cand.axis,
         "directions": directions,
-        "costs": costs,
+        "costs": cand.costs,
         "com": com,
-        "com_factor": factors,
         "best": np.array([kb, pb]),
         "pose": pose,
         "width": np.float64(width),
     }
     return PlanResult(grasp=grasp, details=details)
+
+
+def _pads_hold(
+    pl,
+    geometry: GripperGeometry,
+    points: np.ndarray,
+    normals: np.ndarray,
+    area_mask: np.ndarray,
+    poses: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Step 3 of the module doc for (B, 4, 4) poses: (B,) whether both pads' contacts are at least
+    ``min_pad_depth_m`` deep, inside the friction cone of ``friction_coef`` and at least
+    ``min_contacts_in_area`` in the grasping area, and (B,) the depth, m."""
+    local_normals = normals[None] @ poses[:, :3, :3]
+    depth, angle, share = pad_contacts(
+        local_coords(points, poses), local_normals, geometry, pl.contact_band_m, area_mask
+    )
+    ok = (depth >= pl.min_pad_depth_m) & (angle <= np.arctan(pl.friction_coef))
+    return ok & (share >= pl.min_contacts_in_area), depth
+
+
+def _roll(angle_rad: float) -> np.ndarray:
+    """(3, 3) rotation of a grasp frame about its own approach axis +Z by ``angle_rad``."""
+    c, s = np.cos(angle_rad), np.sin(angle_rad)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _noise_pass(
+    req: PlanRequest, points: np.ndarray, poses: np.ndarray, widths: np.ndarray, geometry: GripperGeometry
+) -> np.ndarray:
+    """(B,) share of the pose-noise draws (module doc, step 5) under which each grasp still passes."""
+    pl = req.planner
+    if pl.noise_samples == 0 or (pl.noise_trans_mm == 0 and pl.noise_rot_deg == 0):
+        return np.ones(len(poses))
+    motions = pose_perturbations(
+        rng_for(req.seed, "optimal_plus_noise"),
+        pl.noise_samples,
+        pl.noise_trans_mm,
+        pl.noise_rot_deg,
+        np.asarray(req.object_pose)[:3, 3],
+    )
+    normals = np.asarray(req.normals, dtype=np.float64)
+    ok = np.zeros(len(poses))
+    for motion in motions:
+        moved = points @ motion[:3, :3].T + motion[:3, 3]
+        free = cloud_hits(moved, poses, req.gripper, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0) == 0
+        ok += free & _pads_hold(pl, geometry, moved, normals @ motion[:3, :3].T, req.area_mask, poses)[0]
+    return ok / len(motions)

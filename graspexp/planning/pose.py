@@ -64,9 +64,14 @@ def opening_widths_m(radii_m: np.ndarray, width_margin: float, gripper: GripperC
 
 
 def slab_spans_m(
-    points_m: np.ndarray, centers_m: np.ndarray, rotations: np.ndarray, gripper: GripperConfig
+    points_m: np.ndarray,
+    centers_m: np.ndarray,
+    rotations: np.ndarray,
+    gripper: GripperConfig,
+    margin_m: float = 0.0,
 ) -> np.ndarray:
-    """Span ``[y_lo, y_hi]`` along +Y of the object points in the pads' sweep (module doc).
+    """Span ``[y_lo, y_hi]`` along +Y of the object points in the pads' sweep (module doc), the sweep
+    grown by ``margin_m`` along X and Z (the collision checks' clearance, m).
 
     points_m : (N, 3) world, metres; centers_m : (3,) or (B, 3) grasp-frame origins (cluster centres),
     world, metres; rotations : (B, 3, 3) grasp rotations.
@@ -83,7 +88,7 @@ def slab_spans_m(
         np.ascontiguousarray(points_m, dtype=np.float64),
         centers,
         rots,
-        geometry.finger_width_m / 2,
-        geometry.root_z_m,
-        geometry.tip_z_m,
+        geometry.finger_width_m / 2 + margin_m,
+        geometry.root_z_m - margin_m,
+        geometry.tip_z_m + margin_m,
     )

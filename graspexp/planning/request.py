@@ -22,6 +22,9 @@ class PlanRequest:
     planner : the planner's own config (its plugin's schema, a :class:`PlannerConfig` subclass).
     cost : the constants of Eq. (1)-(3).
     seed : seed for anything random in the planner.
+    support_blocks_gripper : whether the support is an obstacle for the fingers and palm
+        (``mode.support_collides_with_gripper``: the bin's table is; the collaborative mode's box, removed
+        after the grasp, is not). Paths through the support plane are dropped either way (III-D).
     """
 
     points: np.ndarray
@@ -34,6 +37,7 @@ class PlanRequest:
     planner: PlannerConfig
     cost: CostConfig
     seed: int
+    support_blocks_gripper: bool = True
 
 
 @dataclass(frozen=True)

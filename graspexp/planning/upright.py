@@ -57,6 +57,7 @@ def upright_request(cfg: Any, model: ObjectModel) -> PlanRequest:
         planner=OmegaConf.to_object(cfg.planner),
         cost=OmegaConf.to_object(cfg.cost),
         seed=derive_seed(derive_seed(cfg.seed, cfg.dataset.name, model.name, UPRIGHT_TRIAL), "plan"),
+        support_blocks_gripper=bool(cfg.mode.support_collides_with_gripper),
     )
 
 

@@ -357,6 +357,7 @@ def _plan(ctx: TrialContext, sim: _Sim) -> Grasp:
         planner=cfg.planner,
         cost=cfg.cost,
         seed=derive_seed(ctx.trial_seed, "plan"),
+        support_blocks_gripper=bool(cfg.mode.support_collides_with_gripper),
     )
     try:
         grasp = ctx.plan(req).grasp

@@ -1,9 +1,11 @@
-"""Schema of ``optimal_plus`` (graspexp/planning/optimal_plus.py): the paper's paths, a swept collision
-check, a geometric opening and a centre-of-mass preference."""
+"""Schema of ``optimal_plus`` (graspexp/planning/optimal_plus.py): the paper's paths and cost, then an
+opening from the geometry, a swept collision check, a pad-depth test, a gravity-arm preference and a
+pose-noise check. Every default below was set from the mechanism it addresses (the measurement that
+shows the mechanism is named), not from the planner's score."""
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
-from graspexp.config.constraints import Interval
+from graspexp.config.constraints import Interval, Options, Vector
 from graspexp.config.planner.base import OPENING_CONSTRAINTS, OpeningConfig
 from graspexp.config.planner.optimal import PAPER_PATHS_CONSTRAINTS, PaperPathsConfig
 from graspexp.config.plugins import PlannerPlugin
@@ -11,11 +13,83 @@ from graspexp.config.plugins import PlannerPlugin
 
 @dataclass
 class OptimalPlusConfig(PaperPathsConfig, OpeningConfig):
+    opening: str = "section"
+    """Opening rule: ``section`` = the object's section between the pads + 2 ``width_clearance_m``;
+    ``cluster`` = at least the paper's 2 r_k (1 + ``width_margin``) too. The swept collision check
+    already keeps the fingers off the object, and 2 r_k of a long cluster exceeds the stroke (power drill:
+    70 of its 162 paths) although its section fits."""
+    cluster_length: str = "finger_width"
+    """Length along the main axis each cluster gets from ``k: auto`` (K = ceil(area length / it)):
+    ``finger_width`` (``gripper.finger_width_m``: the pads touch a strip that wide, so each cluster is
+    one pad-wide place to grasp) or ``stroke`` (``auto_k_stroke_fraction`` of the stroke, as ``optimal``).
+    Long areas then offer grasp points along their whole length, not only the middle of a stroke-long
+    cluster (power drill: the housing ahead of the pistol grip)."""
+    rolls_deg: list[float] = field(default_factory=lambda: [0.0, 90.0])
+    """Rotations of the Fig. 9 frame about the approach tried per path, in order of preference, degrees.
+    0 = the paper's closing across the main axis; 90 = along it, for a path where the object across the
+    main axis exceeds the stroke."""
+    depth_offsets_m: list[float] = field(default_factory=lambda: [-0.02, -0.01, 0.0, 0.01, 0.02, 0.03, 0.04])
+    """Moves of the grasp point along the approach tried per path, m (+ = deeper, towards the palm
+    reaching the object). From 2 cm back (the fingertips off a support just below c_k) to half the RG2
+    finger length in (the paper's c_k is a mean of surface points: on a face seen from above it lies on
+    the surface, 1 cm from the fingertips)."""
+    min_pad_depth_m: float = 0.005
+    """Smallest distance from the fingertips to the centre of either pad's contact, m: a contact centred
+    closer lies on the pad's edge (``contact_band_m`` 4 mm of contact, 1 mm to spare), which the pads'
+    pressure squeezes out along the approach. (0.01, the TCP's depth ``gripper.tcp_from_tip_m``, was the
+    first value: it also rejects face contacts on tapered objects, e.g. every in-area grasp of the iron,
+    whose body is widest at the soleplate; the README's optimal_plus table shows both.)"""
+    pad_depth_target_m: float = 0.025
+    """Pad depth aimed at when several depths pass, m: about a third of the RG2 finger (80 mm), deep
+    enough to hold by the pad's face and short of the palm."""
+    friction_coef: float = 0.5
+    """Coulomb friction the contact test assumes: each pad's contact normal must lie within atan(mu)
+    (26.6 deg at 0.5) of the closing axis. 0.5 is the antipodal baseline's value and half the pads'
+    simulated friction (``gripper.pad_friction`` 1.0, averaged by PhysX with the object's)."""
+    min_contacts_in_area: float = 1.0
+    """Share of each pad's contact points that must be grasping-area points (III-A: the robot grasps
+    the area, not the part a person holds). The grasp point is aimed inside the area, but fingers 8 cm
+    long can close on another part first (the iron's handle above its body)."""
+    contact_band_m: float = 0.004
+    """Points within this of a side's extreme y count as that pad's contacts, m: about the cloud's point
+    spacing (2048 points on a Table 1 object)."""
     com_weight: float = 1.0
-    """optimal_plus: cost factor (1 + com_weight * |c_k - centroid| / object size); 0 switches it off."""
+    """Cost factor ``1 + com_weight * arm / D`` (arm of gravity about the closing axis, D the object's
+    box diagonal, m/m); 0 switches it off. 1: a grasp at the far end of the object costs up to twice a
+    grasp through the centre of mass, within the range of Eq. (1)-(3) between neighbouring paths."""
+    shortlist: int = 16
+    """Paths passing the geometric checks among which the gravity arm and pose noise choose."""
+    noise_trans_mm: float = 3.0
+    """Std-dev of the pose estimator's translation error the grasp must tolerate, mm. The paper gives
+    no accuracy for its estimator; 3 mm is below the 2 cm ADD(-S) threshold its cited estimators are
+    scored by and about the clearance ``width_clearance_m``. 0 switches the check off."""
+    noise_rot_deg: float = 2.0
+    """Std-dev of the estimator's rotation error the grasp must tolerate, degrees."""
+    noise_samples: int = 8
+    """Pose-noise draws per shortlisted path; 0 switches the check off."""
+    noise_min_pass: float = 0.75
+    """Share of the draws a path must pass to compete (else the paths passing most often compete)."""
 
 
-CONSTRAINTS = {**PAPER_PATHS_CONSTRAINTS, **OPENING_CONSTRAINTS, "com_weight": [Interval(0, 100)]}
+CONSTRAINTS = {
+    **PAPER_PATHS_CONSTRAINTS,
+    **OPENING_CONSTRAINTS,
+    "opening": [Options(("section", "cluster"))],
+    "cluster_length": [Options(("finger_width", "stroke"))],
+    "rolls_deg": [Vector(None, Interval(-180, 180, unit="deg"))],
+    "depth_offsets_m": [Vector(None, Interval(-0.5, 0.5, unit="m"))],
+    "min_pad_depth_m": [Interval(-0.5, 0.5, unit="m")],
+    "pad_depth_target_m": [Interval(0, 0.5, unit="m")],
+    "friction_coef": [Interval(0, 10, "right")],
+    "min_contacts_in_area": [Interval(0, 1)],
+    "contact_band_m": [Interval(0, 0.05, "right", "m")],
+    "com_weight": [Interval(0, 100)],
+    "shortlist": [Interval(1, 100_000, integer=True)],
+    "noise_trans_mm": [Interval(0, 100, unit="mm")],
+    "noise_rot_deg": [Interval(0, 90, unit="deg")],
+    "noise_samples": [Interval(0, 1000, integer=True)],
+    "noise_min_pass": [Interval(0, 1)],
+}
 """Allowed values of every key of :class:`OptimalPlusConfig` (see :mod:`graspexp.config.constraints`)."""
 
 PLUGIN = PlannerPlugin(

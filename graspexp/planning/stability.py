@@ -1,0 +1,112 @@
+"""What keeps a planned grasp in the hand once the object is lifted: pad depth, gravity arm, pose noise.
+
+Pure numpy/scipy, world frame, metres. Grasp frames as in :mod:`.collision` (+Z approach, +Y closing
+axis, origin midway between the pads; the fingers span ``[root_z_m, tip_z_m]`` along Z).
+
+- **Pad contacts.** The contact points of a side are the points in the pads' reach (``|x| <= fw/2``,
+  ``z`` in the finger span) within ``band_m`` of that side's extreme ``y`` (the first points a closing
+  pad meets). A side's depth is ``tip_z_m - mean z`` of its contact points: how far from the fingertip
+  the contact is centred. Its angle is the one between the mean outward normal there and the closing
+  axis: a pad pressing on a surface tilted beyond the friction cone (``atan(mu)``) pushes the object
+  along the approach. A grasp held by the fingertip edges (depth near 0) or on slopes is squeezed out
+  when the pads press. A side's share in the area is the fraction of its contact points that are
+  grasping-area points: where the pads will touch, whatever the grasp point was aimed at.
+- **Gravity arm.** Once the support is gone, gravity pulls at the centre of mass; its torque about the
+  closing axis (the line through the grasp point along +Y) is resisted only by the pads' torsional
+  friction. Its arm is ``|Y . ((g - o) x z_world)|``.
+- **Centre of mass.** The planner sees a surface cloud only; the centroid of the solid convex hull of
+  the cloud is its estimate (uniform density). For clouds without a 3-D hull, the point mean.
+- **Pose noise.** The pose the planner is given carries the estimator's error. A grasp is robust when it
+  still passes the collision and depth tests with the cloud moved by poses drawn from that error.
+"""
+
+import numpy as np
+from scipy.spatial import ConvexHull, QhullError
+
+from graspexp.config.gripper import GripperGeometry
+from graspexp.geometry import axis_angle_matrix
+
+
+def volume_centroid_m(points_m: np.ndarray) -> np.ndarray:
+    """(3,) centroid of the solid convex hull of ``points_m`` (N, 3), m (module doc)."""
+    p = np.asarray(points_m, dtype=np.float64)
+    try:
+        hull = ConvexHull(p)
+    except (QhullError, ValueError):
+        return p.mean(axis=0)
+    apex = p[hull.vertices].mean(axis=0)
+    tri = p[hull.simplices]  # (F, 3, 3)
+    vol = np.abs(np.einsum("ij,ij->i", tri[:, 0] - apex, np.cross(tri[:, 1] - apex, tri[:, 2] - apex))) / 6
+    if vol.sum() <= 0:
+        return p.mean(axis=0)
+    centres = (tri.sum(axis=1) + apex) / 4
+    return (vol[:, None] * centres).sum(axis=0) / vol.sum()
+
+
+def gravity_arm_m(poses: np.ndarray, com_m: np.ndarray) -> np.ndarray:
+    """(B,) arm of gravity's torque about each grasp's closing axis, m (module doc).
+
+    poses : (B, 4, 4) world grasp poses; com_m : (3,) world centre of mass.
+    """
+    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)
+    r = np.asarray(com_m, dtype=np.float64)[None] - poses[:, :3, 3]
+    moment = np.cross(r, np.array([0.0, 0.0, 1.0]))
+    return np.abs(np.einsum("bi,bi->b", moment, poses[:, :3, 1]))
+
+
+def pad_contacts(
+    local: np.ndarray,
+    local_normals: np.ndarray,
+    geometry: GripperGeometry,
+    band_m: float,
+    area_mask: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Depth of the shallower side's contact from the fingertips, m, the larger of the two sides' angles
+    between the contact normal and the closing axis, rad (module doc), and the smaller of the two sides'
+    shares of contact points in the grasping area, per grasp.
+
+    local : (B, N, 3) cloud points in each grasp frame; local_normals : (B, N, 3) their outward unit
+    normals in the same frames; area_mask : (N,) bool grasping area (None: all points). A side's normal
+    is the mean of its contact points' normals; the left pad (+Y side) presses against a surface facing
+    +Y. Where a side has no contact point: depth -inf, angle pi and share 0.
+
+    Returns
+    -------
+    depth_m, angle_rad, in_area : (B,) float64.
+    """
+    x, y, z = local[..., 0], local[..., 1], local[..., 2]
+    reach = (np.abs(x) <= geometry.finger_width_m / 2) & (z >= geometry.root_z_m) & (z <= geometry.tip_z_m)
+    hi = np.where(reach, y, -np.inf).max(axis=1, keepdims=True)
+    lo = np.where(reach, y, np.inf).min(axis=1, keepdims=True)
+    depth = np.full(len(local), np.inf)
+    angle = np.zeros(len(local))
+    share = np.ones(len(local))
+    inside = np.ones(local.shape[1], dtype=bool) if area_mask is None else np.asarray(area_mask, dtype=bool)
+    for sign, side in ((1.0, reach & (y >= hi - band_m)), (-1.0, reach & (y <= lo + band_m))):
+        n = side.sum(axis=1)
+        some = n > 0
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mean_z = np.where(side, z, 0.0).sum(axis=1) / n
+        depth = np.minimum(depth, np.where(some, geometry.tip_z_m - mean_z, -np.inf))
+        normal = np.where(side[..., None], local_normals, 0.0).sum(axis=1)  # (B, 3)
+        length = np.linalg.norm(normal, axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            cos = np.clip(sign * normal[:, 1] / length, -1.0, 1.0)
+        angle = np.maximum(angle, np.where(some & (length > 0), np.arccos(cos), np.pi))
+        share = np.minimum(share, np.where(some, (side & inside).sum(axis=1) / np.maximum(n, 1), 0.0))
+    return depth, angle, share
+
+
+def pose_perturbations(
+    rng: np.random.Generator, n: int, trans_mm: float, rot_deg: float, origin_m: np.ndarray
+) -> np.ndarray:
+    """(n, 4, 4) world rigid motions drawn like :func:`graspexp.sim.trial.perceived_pose`'s error:
+    a rotation about a random axis by a Gaussian angle (std ``rot_deg``) about ``origin_m`` (the
+    object's origin, world, m), then a Gaussian translation (std ``trans_mm`` per axis)."""
+    out = np.tile(np.eye(4), (n, 1, 1))
+    origin = np.asarray(origin_m, dtype=np.float64)
+    for i in range(n):
+        rot = axis_angle_matrix(rng.normal(size=3), np.deg2rad(rng.normal(0.0, rot_deg)))
+        out[i, :3, :3] = rot
+        out[i, :3, 3] = origin - rot @ origin + rng.normal(0.0, trans_mm, size=3) / 1000.0
+    return out
