@@ -48,7 +48,9 @@ def tool_parser(prog: str, description: str, overrides: bool = False) -> argpars
     """The argument parser every tool starts from: ``prog`` (``graspexp.<tool>``) in its usage and errors;
     with ``overrides`` it takes any number of ``key=value`` Hydra overrides (``args.overrides``), anywhere
     among the options (parse them with ``parse_intermixed_args``)."""
-    parser = argparse.ArgumentParser(prog=prog, description=description)
+    parser = argparse.ArgumentParser(
+        prog=prog, description=description, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     if overrides:
         parser.add_argument("overrides", nargs="*", metavar="key=value", help=OVERRIDES_HELP)
     return parser

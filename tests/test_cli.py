@@ -26,6 +26,7 @@ TOOLS = {
     "graspexp.bench.plan_latency": "bench.plan_latency",
     "graspexp.bench.collision_shapes": "bench.collision_shapes",
     "graspexp.bench.compare_runs": "bench.compare_runs",
+    "graspexp.benchmark": "benchmark",
 }
 
 
