@@ -48,8 +48,9 @@ from graspexp.record import (
     trial_recorder,
 )
 from graspexp.record.scene import ObjectScene, object_scene
+from graspexp.seeding import trial_seed
 from graspexp.sim.collision_shapes import collision_shape
-from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
+from graspexp.sim.trial import TrialContext, plain_config, run_trial
 
 log = logging.getLogger(__name__)
 RESULT_NEUTRAL_KEYS = (
