@@ -128,12 +128,18 @@ def expand_sweeps(overrides: Sequence[str]) -> list[list[str]]:
     return [list(combo) for combo in itertools.product(*choices.values())]
 
 
-def check_overrides(overrides: Sequence[str]) -> None:
-    """Compose and validate every combination of the (possibly swept) overrides; exit 2 on the first error."""
+def check_overrides(overrides: Sequence[str], multirun: bool = True) -> None:
+    """Compose and validate every combination of the (possibly swept) overrides; exit 2 on the first error
+    (also for a sweep without ``multirun``)."""
     try:
         combos = expand_sweeps(overrides)
     except Exception as exc:  # a syntax error in an override
         fail(_one_line(exc))
+    if len(combos) > 1 and not multirun:
+        swept = [o for o in overrides if len(expand_sweeps([o])) > 1]
+        fail(
+            f"{' '.join(swept)} sweeps over several values: add -m (--multirun), or give a list as key=[a,b]"
+        )
     for combo in combos:
         compose_checked(combo)
 
@@ -211,5 +217,5 @@ def run_checked(hydra_main: Callable[[], object], argv: list[str] | None = None)
         _shell_completion(args.overrides, hydra_main)
         return
     if not (args.hydra_help or args.info):
-        check_overrides(args.overrides)
+        check_overrides(args.overrides, multirun=args.multirun)
     hydra_main()

@@ -78,6 +78,15 @@ def test_shell_completion_without_a_command_is_one_line():
     )
 
 
+def test_a_sweep_without_multirun_is_one_line():
+    proc = _graspexp("mode=collab,bin", "trials=1")
+    assert proc.returncode == 2
+    assert proc.stderr == (
+        "graspexp: error: mode=collab,bin sweeps over several values: add -m (--multirun), or give a list "
+        "as key=[a,b]\n"
+    )
+
+
 def test_two_modes_are_refused_by_the_parser():
     proc = _graspexp("-m", "--cfg", "job", "mode=bin")
     assert proc.returncode == 2
