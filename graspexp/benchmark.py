@@ -1,21 +1,23 @@
-"""``python -m graspexp.benchmark planner=NAME [dataset=...] [key=value ...]``: the standard suite for any
-installed planner, ranked beside the built-in planners and the paper's published numbers.
+"""``python -m graspexp.benchmark [--option ...] planner=NAME [dataset=...] [key=value ...]``: the standard
+suite for any installed planner, ranked beside the built-in planners and the paper's published numbers.
 
 The standard suite: the paper's four settings (collab / bin x rotation z / xyz) on Table 1 (``ycb``) and
 Table 2 (``linemod``), :data:`graspexp.report.paper.TRIALS_PER_SETTING` trials per object, at zero pose
 noise and at each of :data:`NOISE_LEVELS`. Every planner runs the same drops (a drop depends only on the
-seed, dataset, object and trial index). Keys (``key=value``; values in YAML):
+seed, dataset, object and trial index).
 
-- ``planner`` (required): the planner entered; ``dataset``: one dataset or a list (default ycb, linemod);
-- ``settings``: list of ``mode/rot`` (default the four); ``trials``; ``objects``: a subset;
-  ``noise``: list of ``[trans_mm, rot_deg]`` levels besides zero (``[]``: none);
-- ``compare``: planners ranked beside it (default the built-in ones; they run too where their results
-  are missing, once, and are reused by every later entrant); ``out`` (default ``outputs/benchmark``);
-- ``n_jobs`` (default 2): jobs in parallel with joblib; ``launcher=submitit``: one SLURM array task per
-  job through submitit (``slurm_partition=``, ``timeout_min=``; where no SLURM exists submitit runs them
-  as local processes);
-- any other ``key=value`` is a job override: ``planner.*`` for the entered planner only, the rest
-  (``gripper=``, ``sim.*``, ...) for every planner.
+``key=value`` arguments are job overrides, as for every tool: ``planner=NAME`` (required) is the planner
+entered; ``dataset=`` one dataset or several (``dataset=ycb,linemod``, the default); ``trials=``;
+``objects=[...]`` a subset; ``planner.*`` keys go to the entered planner only, the rest (``gripper=``,
+``sim.*``, ...) to every planner. Options:
+
+- ``--settings collab/z,bin/xyz``: the settings (default the four);
+- ``--noise 10:0,0:10``: pose-noise levels ``trans_mm:rot_deg`` besides zero (``--noise ''``: none);
+- ``--compare obb,random``: planners ranked beside it (default the built-in ones; they run too where
+  their results are missing, once, and are reused by every later entrant);
+- ``--out DIR`` (default ``outputs/benchmark``); ``--n-jobs N`` (default 2): jobs in parallel with joblib;
+- ``--launcher submitit``: one SLURM array task per job through submitit (``--slurm-partition``,
+  ``--timeout-min``; where no SLURM exists submitit runs them as local processes).
 
 Output, one folder per planner, ``OUT/<planner>/``: ``runs/<dataset>/<mode>_<rot>_t<mm>_r<deg>/`` (the
 runner's job directories: resumable, locked, one MCAP log per trial), ``summary.md`` (ranking and tables),
@@ -25,6 +27,7 @@ config, package versions, planner package and version). Re-running the same comm
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import json
 import math
@@ -36,10 +39,10 @@ import pandas as pd
 import yaml
 from omegaconf import OmegaConf
 
-from graspexp.cli import compose_config, fail
+from graspexp.cli import compose_checked, compose_config, fail, tool_parser
 from graspexp.compare.report import FC_MU, check_same_drops, render_markdown
 from graspexp.compare.report import success_by_noise as noise_success_table
-from graspexp.config import ConfigError, PluginError, validate
+from graspexp.config import ConfigError, PluginError
 from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
 from graspexp.report.collect import collect
 from graspexp.report.contact_area import IN_AREA_TOLERANCE_M, finger_contacts_in_area
@@ -89,31 +92,61 @@ class Job:
     run_dir: str
 
 
+PROG = "graspexp.benchmark"
+SUITE_KEYS = ("planner", "dataset", "trials", "objects")
+"""Job keys whose values choose the suite (the other overrides are passed on to every job)."""
+
+
+def _names(text: str) -> list[str]:
+    """``a,b`` or ``[a,b]`` -> ``["a", "b"]``."""
+    return [t.strip() for t in text.strip().strip("[]").split(",") if t.strip()]
+
+
+def _noise_levels(text: str) -> list[list[float]]:
+    """``10:0,0:10`` -> ``[[10.0, 0.0], [0.0, 10.0]]``; ``''`` -> ``[]``."""
+    try:
+        return [[float(v) for v in level.split(":")] for level in _names(text)]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: expected trans_mm:rot_deg levels, e.g. 10:0,0:10"
+        ) from None
+
+
+def arg_parser() -> argparse.ArgumentParser:
+    """The benchmark's command line (module doc)."""
+    parser = tool_parser(PROG, __doc__, overrides=True)
+    parser.add_argument("--settings", type=_names, help="comma-separated mode/rot (default: the four)")
+    parser.add_argument("--noise", type=_noise_levels, help="trans_mm:rot_deg levels besides zero")
+    parser.add_argument(
+        "--compare", type=_names, help="planners ranked beside it (default: the built-in ones)"
+    )
+    parser.add_argument("--out", default=Benchmark.out, help=f"output folder (default {Benchmark.out})")
+    parser.add_argument("--n-jobs", type=int, default=Benchmark.n_jobs, help="jobs in parallel (joblib)")
+    parser.add_argument("--launcher", choices=("joblib", "submitit"), default=Benchmark.launcher)
+    parser.add_argument("--slurm-partition", default=Benchmark.slurm_partition, help="with submitit")
+    parser.add_argument("--timeout-min", type=int, default=Benchmark.timeout_min, help="with submitit")
+    return parser
+
+
 def parse_args(argv: list[str]) -> Benchmark:
-    """``key=value`` tokens -> :class:`Benchmark`; unknown keys become job overrides."""
-    keys = {f.name for f in dataclasses.fields(Benchmark)} - {"overrides", "datasets"}
+    """The command line (module doc) -> :class:`Benchmark`."""
+    args = arg_parser().parse_intermixed_args(argv)
     values: dict = {"overrides": []}
-    for tok in argv:
+    for tok in args.overrides:
         key, sep, raw = tok.partition("=")
-        if not sep:
-            raise ConfigError(
-                f"{tok!r} is invalid: expected key=value (python -m graspexp.benchmark planner=NAME)"
-            )
-        if key == "dataset":
-            value = yaml.safe_load(raw)
-            values["datasets"] = value if isinstance(value, list) else [str(value)]
-        elif key in keys:
-            values[key] = yaml.safe_load(raw) if key not in ("planner", "out") else raw
-        else:
+        if key not in SUITE_KEYS or not sep:
             values["overrides"].append(tok)
+        elif key == "dataset":
+            values["datasets"] = _names(raw)
+        else:
+            values[key] = yaml.safe_load(raw) if key != "planner" else raw
     if "planner" not in values:
         raise ConfigError("planner is missing: python -m graspexp.benchmark planner=NAME [dataset=...]")
-    bench = Benchmark(**values)
+    options = ("settings", "noise", "compare", "out", "n_jobs", "launcher", "slurm_partition", "timeout_min")
+    bench = Benchmark(**values, **{k: getattr(args, k) for k in options if getattr(args, k) is not None})
     for s in bench.settings:
         if s.count("/") != 1:
-            raise ConfigError(f"settings entry {s!r} is invalid: expected mode/rot, e.g. collab/z")
-    if bench.launcher not in ("joblib", "submitit"):
-        raise ConfigError(f"launcher={bench.launcher!r} is invalid: expected one of joblib, submitit")
+            raise ConfigError(f"--settings entry {s!r} is invalid: expected mode/rot, e.g. collab/z")
     return bench
 
 
@@ -324,22 +357,14 @@ def write_summary(
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
-    if any(a in ("-h", "--help") for a in argv):
-        print(__doc__)
-        return 0
     try:
         bench = parse_args(argv)
         get_plugin(bench.planner)
-        all_jobs = jobs(bench)
-        configs = []
-        for job in all_jobs:  # every job's config is checked before the first trial runs
-            cfg = compose_config(list(job.overrides))
-            validate(cfg)
-            configs.append(OmegaConf.to_container(cfg, resolve=True))
     except (ConfigError, PluginError) as exc:
-        fail(str(exc))
-    except Exception as exc:  # Hydra composition errors: one line, no traceback
-        fail(str(exc).splitlines()[0])
+        fail(str(exc), PROG)
+    all_jobs = jobs(bench)
+    # every job's config is checked before the first trial runs
+    configs = [OmegaConf.to_container(compose_checked(j.overrides, PROG), resolve=True) for j in all_jobs]
     errors = run_all(bench, all_jobs)
     print(write_summary(bench, all_jobs, configs, errors, argv), end="")
     print(f"graspexp.benchmark: results in {Path(bench.out) / bench.planner}", file=sys.stderr)

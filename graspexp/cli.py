@@ -48,7 +48,9 @@ def tool_parser(prog: str, description: str, overrides: bool = False) -> argpars
     """The argument parser every tool starts from: ``prog`` (``graspexp.<tool>``) in its usage and errors;
     with ``overrides`` it takes any number of ``key=value`` Hydra overrides (``args.overrides``), anywhere
     among the options (parse them with ``parse_intermixed_args``)."""
-    parser = argparse.ArgumentParser(prog=prog, description=description)
+    parser = argparse.ArgumentParser(
+        prog=prog, description=description, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     if overrides:
         parser.add_argument("overrides", nargs="*", metavar="key=value", help=OVERRIDES_HELP)
     return parser
@@ -126,12 +128,18 @@ def expand_sweeps(overrides: Sequence[str]) -> list[list[str]]:
     return [list(combo) for combo in itertools.product(*choices.values())]
 
 
-def check_overrides(overrides: Sequence[str]) -> None:
-    """Compose and validate every combination of the (possibly swept) overrides; exit 2 on the first error."""
+def check_overrides(overrides: Sequence[str], multirun: bool = True) -> None:
+    """Compose and validate every combination of the (possibly swept) overrides; exit 2 on the first error
+    (also for a sweep without ``multirun``)."""
     try:
         combos = expand_sweeps(overrides)
     except Exception as exc:  # a syntax error in an override
         fail(_one_line(exc))
+    if len(combos) > 1 and not multirun:
+        swept = [o for o in overrides if len(expand_sweeps([o])) > 1]
+        fail(
+            f"{' '.join(swept)} sweeps over several values: add -m (--multirun), or give a list as key=[a,b]"
+        )
     for combo in combos:
         compose_checked(combo)
 
@@ -209,5 +217,5 @@ def run_checked(hydra_main: Callable[[], object], argv: list[str] | None = None)
         _shell_completion(args.overrides, hydra_main)
         return
     if not (args.hydra_help or args.info):
-        check_overrides(args.overrides)
+        check_overrides(args.overrides, multirun=args.multirun)
     hydra_main()

@@ -13,6 +13,7 @@ ended in ``error`` and partial logs are redone. One job at a time writes into a 
 With ``record=false`` no log is written (faster, but nothing to replay and nothing to resume from).
 """
 
+import dataclasses
 import datetime
 import logging
 import os
@@ -47,8 +48,9 @@ from graspexp.record import (
     trial_recorder,
 )
 from graspexp.record.scene import ObjectScene, object_scene
+from graspexp.seeding import trial_seed
 from graspexp.sim.collision_shapes import collision_shape
-from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
+from graspexp.sim.trial import TrialContext, plain_config, run_trial
 
 log = logging.getLogger(__name__)
 RESULT_NEUTRAL_KEYS = (
@@ -206,16 +208,33 @@ def _neutral(key: str) -> bool:
     return any(key == n or key.startswith(n + ".") for n in RESULT_NEUTRAL_KEYS)
 
 
+_NO_DEFAULT = object()
+
+
+def _schema_default(cfg: DictConfig, key: str) -> object:
+    """The default that the schema of dotted ``key``'s node in ``cfg`` gives it, else ``_NO_DEFAULT``."""
+    parent, _, leaf = key.rpartition(".")
+    node = OmegaConf.select(cfg, parent) if parent else cfg
+    schema = OmegaConf.get_type(node) if isinstance(node, DictConfig) else None
+    for f in dataclasses.fields(schema) if dataclasses.is_dataclass(schema) else ():
+        if f.name == leaf and f.default is not dataclasses.MISSING:
+            return f.default
+    return _NO_DEFAULT
+
+
 def config_differences(recorded_yaml: str, cfg: DictConfig) -> dict[str, tuple[object, object]]:
     """dotted key -> (value in the log, value now) for every key that affects a result and differs; a key
-    absent on one side shows as ``<absent>``."""
+    absent on one side shows as ``<absent>``. A key the log lacks that now has its schema's default is not
+    a difference: it was added to graspexp after the log was written, with the value the code had before."""
     old = _flatten(OmegaConf.to_container(OmegaConf.create(recorded_yaml), resolve=True))
     new = _flatten(OmegaConf.to_container(cfg, resolve=True))
     absent = "<absent>"
     return {
         k: (old.get(k, absent), new.get(k, absent))
         for k in sorted(old.keys() | new.keys())
-        if not _neutral(k) and old.get(k, absent) != new.get(k, absent)
+        if not _neutral(k)
+        and old.get(k, absent) != new.get(k, absent)
+        and not (k not in old and k in new and new[k] == _schema_default(cfg, k))
     }
 
 

@@ -26,6 +26,7 @@ TOOLS = {
     "graspexp.bench.plan_latency": "bench.plan_latency",
     "graspexp.bench.collision_shapes": "bench.collision_shapes",
     "graspexp.bench.compare_runs": "bench.compare_runs",
+    "graspexp.benchmark": "benchmark",
 }
 
 
@@ -74,6 +75,15 @@ def test_shell_completion_without_a_command_is_one_line():
     assert proc.returncode == 2
     assert proc.stderr == (
         "graspexp: error: --shell-completion needs install=bash, uninstall=bash or query=bash, got ''\n"
+    )
+
+
+def test_a_sweep_without_multirun_is_one_line():
+    proc = _graspexp("mode=collab,bin", "trials=1")
+    assert proc.returncode == 2
+    assert proc.stderr == (
+        "graspexp: error: mode=collab,bin sweeps over several values: add -m (--multirun), or give a list "
+        "as key=[a,b]\n"
     )
 
 

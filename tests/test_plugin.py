@@ -48,13 +48,13 @@ def test_example_plugin_runs_through_the_benchmark_beside_a_builtin_planner(tmp_
         "graspexp.benchmark",
         "planner=top_down",
         "dataset=primitives",
-        "settings=[collab/z]",
+        "--settings=collab/z",
         "trials=1",
         "objects=[can]",
-        "noise=[]",
-        "compare=[obb]",
-        "n_jobs=1",
-        f"out={out}",
+        "--noise=",
+        "--compare=obb",
+        "--n-jobs=1",
+        f"--out={out}",
         "planner.clearance_m=0.004",
     ]
     proc = _run(args, env, tmp_path)
@@ -104,7 +104,7 @@ def test_a_broken_or_unknown_plugin_is_one_line_naming_it(tmp_path):
     assert ok.returncode == 0, ok.stderr
     unknown = _run(["graspexp.benchmark", "planner=nope"], env, REPO)
     assert unknown.returncode == 2 and unknown.stderr.startswith(
-        "graspexp: error: planner.name='nope' is unknown"
+        "graspexp.benchmark: error: planner.name='nope' is unknown"
     )
 
 

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from omegaconf import OmegaConf
 from omegaconf.errors import ReadonlyConfigError
 
 from graspexp.datasets import DatasetError
@@ -82,6 +83,16 @@ def test_config_differences_name_every_result_key_and_skip_neutral_ones() -> Non
     assert config_differences(recorded, compose_cfg("objects=[box]", "trials=5", "progress=false")) == {}
     diff = config_differences(recorded, compose_cfg(*BASE, "sim.close_s=0.8", "gripper=panda"))
     assert diff["sim.close_s"] == (0.6, 0.8) and diff["gripper.name"] == ("rg2", "panda")
+
+
+def test_a_key_added_since_the_log_counts_as_equal_only_at_its_default() -> None:
+    recorded = OmegaConf.create(job_metadata(compose_cfg(*BASE))["config_yaml"])
+    del recorded.sim["min_finger_force_n"]  # a log written before the key existed
+    old_log = OmegaConf.to_yaml(recorded)
+    assert config_differences(old_log, compose_cfg(*BASE)) == {}
+    assert config_differences(old_log, compose_cfg(*BASE, "sim.min_finger_force_n=2")) == {
+        "sim.min_finger_force_n": ("<absent>", 2.0)
+    }
 
 
 @pytest.mark.parametrize(

@@ -10,10 +10,11 @@ from graspexp.planning import plan
 from graspexp.planning.grasp import Grasp
 from graspexp.planning.request import PlanResult
 from graspexp.quality import fc_min_mu
+from graspexp.seeding import trial_seed
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.contacts import GRIPPER_LINKS
 from graspexp.sim.scene import SUPPORT_NAME
-from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial, trial_seed
+from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
 from tests.conftest import compose_cfg
 
 pytestmark = pytest.mark.sim

@@ -14,8 +14,9 @@ from graspexp.planning import plan
 from graspexp.quality import fc_min_mu
 from graspexp.record import TrialRecorder, read_trial
 from graspexp.record.scene import object_scene
+from graspexp.seeding import trial_seed
 from graspexp.sim.collision_shapes import collision_shape
-from graspexp.sim.trial import TrialContext, plain_config, run_trial, trial_seed
+from graspexp.sim.trial import TrialContext, plain_config, run_trial
 
 pytestmark = [pytest.mark.sim, pytest.mark.slow]
 REPO = Path(__file__).resolve().parent.parent

@@ -31,10 +31,11 @@ from graspexp.datasets import job_object
 from graspexp.planning import plan
 from graspexp.prepare import staged_objects
 from graspexp.quality import fc_min_mu
+from graspexp.seeding import trial_seed
 from graspexp.sim.collision_accuracy import shape_accuracy, surface_points, uncovered_m
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.scene import build_scene
-from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial, trial_seed
+from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
 
 REST_STEPS = 600
 """Steps of the resting scene (2.5 s at 1/240 s), after the object has landed."""

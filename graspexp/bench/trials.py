@@ -25,8 +25,9 @@ from graspexp.planning import plan
 from graspexp.quality import fc_min_mu
 from graspexp.record import TrialRecorder
 from graspexp.record.scene import object_scene
+from graspexp.seeding import trial_seed
 from graspexp.sim.collision_shapes import collision_shape
-from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial, trial_seed
+from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
 
 PHASES = ("build", "settle", "plan", "quality", "execute", "log")
 TARGET_LOGGED, TARGET_UNLOGGED = 1.3, 1.2

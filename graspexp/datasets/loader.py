@@ -28,7 +28,7 @@ from graspexp.datasets.meshcheck import check_bop_info, check_file, check_geomet
 from graspexp.datasets.model import ObjectModel
 from graspexp.datasets.primitives import PRIMITIVES
 from graspexp.datasets.regions import area_mask, load_region_specs, regions_path
-from graspexp.seeding import derive_seed
+from graspexp.seeding import cloud_seed
 
 log = logging.getLogger(__name__)
 
@@ -174,9 +174,9 @@ def load_object(cfg: Any, name: str, n_points: int, seed: int) -> ObjectModel:
 
 def job_object(job: Any, name: str) -> ObjectModel:
     """Object ``name`` as every trial of job config ``job`` sees it: dataset ``job.dataset``, a cloud of
-    ``job.planner.n_points`` samples seeded by ``derive_seed(job.seed, "cloud", name)`` (the same cloud
+    ``job.planner.n_points`` samples seeded by :func:`graspexp.seeding.cloud_seed` (the same cloud
     for every trial of the object, in the runner, ``graspexp.plan``, re-simulation and the benches)."""
-    return load_object(job.dataset, name, int(job.planner.n_points), derive_seed(job.seed, "cloud", name))
+    return load_object(job.dataset, name, int(job.planner.n_points), cloud_seed(job, name))
 
 
 def select_objects(dataset: Any, objects: list[str] | None) -> list[str]:

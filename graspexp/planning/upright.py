@@ -3,7 +3,7 @@ and the planner bench show (no simulation; the object is not dropped).
 
 The pose is the identity rotation translated so that the mesh's lowest point sits on
 ``z = mode.support_height_m`` (x = y = 0). The plan's seed is the runner's for trial
-:data:`UPRIGHT_TRIAL`: ``derive_seed(derive_seed(seed, dataset, object, 0), "plan")``.
+:data:`UPRIGHT_TRIAL` (:func:`graspexp.seeding.plan_seed`).
 """
 
 import time
@@ -16,7 +16,7 @@ from omegaconf import OmegaConf
 from graspexp.datasets import ObjectModel
 from graspexp.planning.registry import plan
 from graspexp.planning.request import PlanRequest, PlanResult
-from graspexp.seeding import derive_seed
+from graspexp.seeding import plan_seed, trial_seed
 
 UPRIGHT_TRIAL = 0
 """The trial index whose planner seed an upright plan uses."""
@@ -56,7 +56,7 @@ def upright_request(cfg: Any, model: ObjectModel) -> PlanRequest:
         gripper=OmegaConf.to_object(cfg.gripper),
         planner=OmegaConf.to_object(cfg.planner),
         cost=OmegaConf.to_object(cfg.cost),
-        seed=derive_seed(derive_seed(cfg.seed, cfg.dataset.name, model.name, UPRIGHT_TRIAL), "plan"),
+        seed=plan_seed(trial_seed(cfg, model.name, UPRIGHT_TRIAL)),
         support_blocks_gripper=bool(cfg.mode.support_collides_with_gripper),
     )
 

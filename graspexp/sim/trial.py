@@ -23,7 +23,7 @@ from graspexp.geometry import axis_angle_matrix, make_pose, random_rotation, tra
 from graspexp.outcome import FailureReason, TrialResult
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.request import PlanRequest, PlanResult
-from graspexp.seeding import derive_seed, rng_for
+from graspexp.seeding import plan_seed, rng_for
 from graspexp.sim.contacts import SupportTouch, contact_records, finger_forces
 from graspexp.sim.gripper import FINGER_NAMES, Gripper, build_gripper
 from graspexp.sim.scene import SUPPORT_NAME, TrialScene, build_scene
@@ -112,11 +112,6 @@ class TrialContext:
 def plain_config(cfg: DictConfig) -> JobConfig:
     """The composed job config as dataclass instances (attribute access in the step loop must be cheap)."""
     return OmegaConf.to_object(cfg)
-
-
-def trial_seed(cfg: JobConfig, object_name: str, trial: int) -> int:
-    """Seed of one trial from (global seed, dataset, object, trial index)."""
-    return derive_seed(cfg.seed, cfg.dataset.name, object_name, trial)
 
 
 def drop_pose(
@@ -356,7 +351,7 @@ def _plan(ctx: TrialContext, sim: _Sim) -> Grasp:
         gripper=cfg.gripper,
         planner=cfg.planner,
         cost=cfg.cost,
-        seed=derive_seed(ctx.trial_seed, "plan"),
+        seed=plan_seed(ctx.trial_seed),
         support_blocks_gripper=bool(cfg.mode.support_collides_with_gripper),
     )
     try:
