@@ -48,7 +48,7 @@ from graspexp.report.collect import collect
 from graspexp.report.contact_area import IN_AREA_TOLERANCE_M, finger_contacts_in_area
 from graspexp.report.paper import PAPER_TABLES, SETTINGS, TRIALS_PER_SETTING
 from graspexp.report.render import display_frame, footnotes, markdown
-from graspexp.report.stats import percentiles, wilson_interval
+from graspexp.report.stats import percentiles, success_pct
 from graspexp.report.tables import failure_breakdown, success_table
 
 NOISE_LEVELS: tuple[tuple[float, float], ...] = ((10.0, 0.0), (20.0, 0.0), (0.0, 10.0))
@@ -57,7 +57,7 @@ IN_AREA_NOTE = (
     "In-area contact %: share of the finger-object contacts at the end of closing that lie within "
     f"{IN_AREA_TOLERANCE_M * 1000:g} mm of a grasping-area point of the object's cloud "
     "(graspexp/report/contact_area.py; from each log's /contacts and /tf), over the trials whose fingers "
-    "touch the object then."
+    "touch the object then. Trials all in area %: share of those trials whose every contact is in the area."
 )
 
 
@@ -240,9 +240,9 @@ def results(all_jobs: list[Job]) -> pd.DataFrame:
 
 
 def _success(g: pd.DataFrame) -> str:
-    k, n = int(g["success"].sum()), len(g)
-    lo, hi = wilson_interval(k, n)
-    return f"{100 * k / n:.0f} [{100 * lo:.0f}, {100 * hi:.0f}] ({n})" if n else "n/a"
+    n = len(g)
+    rate, lo, hi = success_pct(int(g["success"].sum()), n)
+    return f"{rate:.0f} [{lo:.0f}, {hi:.0f}] ({n})" if n else "n/a"
 
 
 def ranking(df: pd.DataFrame, dataset: str, settings: list[str]) -> pd.DataFrame:
@@ -258,6 +258,10 @@ def ranking(df: pd.DataFrame, dataset: str, settings: list[str]) -> pd.DataFrame
         planned = g[g["reason"] != "no_feasible_grasp"]
         touched = int(g["contacts"].sum())
         row["in-area contact %"] = f"{100 * g['contacts_in_area'].sum() / touched:.0f}" if touched else "n/a"
+        held = g[g["contacts"] > 0]
+        row["trials all in area %"] = (
+            f"{100 * (held['contacts_in_area'] == held['contacts']).mean():.0f}" if len(held) else "n/a"
+        )
         row[f"force-closure % (mu<={FC_MU:g})"] = (
             f"{100 * (planned['fc_min_mu'] <= FC_MU + 1e-9).mean():.0f}" if len(planned) else "n/a"
         )

@@ -41,6 +41,7 @@ import numpy as np
 
 from graspexp.config.gripper import GripperGeometry
 from graspexp.planning.collision import cloud_hits, place_for_request
+from graspexp.planning.friction import cone_cosine
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.optimal import paper_candidates
 from graspexp.planning.pose import grasp_rotations, opening_widths_m
@@ -201,7 +202,7 @@ def _pads_hold(
     ``min_pad_depth_m`` deep, inside the friction cone of ``friction_coef`` and at least
     ``min_contacts_in_area`` in the grasping area, and (B,) the depth, m."""
     depth, angle, share = pad_contacts(points, normals, poses, geometry, pl.contact_band_m, area_mask)
-    ok = (depth >= pl.min_pad_depth_m) & (angle <= np.arctan(pl.friction_coef))
+    ok = (depth >= pl.min_pad_depth_m) & (np.cos(angle) >= cone_cosine(pl.friction_coef))
     return ok & (share >= pl.min_contacts_in_area), depth
 
 

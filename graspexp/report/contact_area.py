@@ -21,7 +21,7 @@ from graspexp.config import DatasetConfig
 from graspexp.datasets import load_object
 from graspexp.geometry import make_pose, quat_wxyz_to_matrix, transform_points
 from graspexp.record import read_trial
-from graspexp.seeding import derive_seed
+from graspexp.seeding import cloud_seed
 
 IN_AREA_TOLERANCE_M = 0.005
 """A contact within this of a grasping-area point is in the area, m: about the spacing of a 2048-point
@@ -34,7 +34,7 @@ OBJECT = "object"
 @functools.lru_cache(maxsize=64)
 def _area_index(dataset_yaml: str, name: str, n_points: int, seed: int) -> cKDTree:
     dataset = OmegaConf.merge(OmegaConf.structured(DatasetConfig), OmegaConf.create(dataset_yaml))
-    model = load_object(dataset, name, n_points, derive_seed(seed, "cloud", name))
+    model = load_object(dataset, name, n_points, seed)
     return cKDTree(model.points[model.area_mask])
 
 
@@ -67,9 +67,8 @@ def finger_contacts_in_area(path: Path | str) -> tuple[int, int]:
     world_from_object = make_pose(quat_wxyz_to_matrix(quat[j]), pos[j])
     local = transform_points(np.linalg.inv(world_from_object), np.array([c["position"] for c in pairs]))
     cfg = OmegaConf.create(log.metadata["config_yaml"])
-    tree = _area_index(
-        OmegaConf.to_yaml(cfg.dataset), log.result["object"], int(cfg.planner.n_points), int(cfg.seed)
-    )
+    name = log.result["object"]
+    tree = _area_index(OmegaConf.to_yaml(cfg.dataset), name, int(cfg.planner.n_points), cloud_seed(cfg, name))
     return int(in_area(local, tree).sum()), len(pairs)
 
 
