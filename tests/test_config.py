@@ -176,7 +176,7 @@ def test_each_planner_has_its_own_schema_and_the_names_come_from_the_registry():
     ):
         validate(compose_cfg("planner.name=???"))
     with pytest.raises(
-        ConfigError, match=r"^planner.name='nope' is unknown: expected one of antipodal, obb,"
+        ConfigError, match=r"^planner.name='nope' is unknown: expected one of antipodal, antipodal_area, obb,"
     ):
         validate(compose_cfg("planner.name=nope"))
 
