@@ -81,6 +81,7 @@ NOISE = ("perception.noise.trans_mm=3", "perception.noise.rot_deg=2")
 """The pose noise the robustness rows add: 3 mm / 2 degrees std-dev, what optimal_plus assumes."""
 PLUS = ("planner=optimal_plus", "record=false")
 ABLATIONS: tuple[Reading, ...] = (
+    Reading("plus", PLUS, "optimal_plus as configured (the rows below change one thing)"),
     Reading(
         "plus_opening_cluster", (*PLUS, "planner.opening=cluster"), "optimal_plus, opening >= 2 r_k (1.2)"
     ),
