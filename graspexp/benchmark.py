@@ -57,7 +57,8 @@ IN_AREA_NOTE = (
     "In-area contact %: share of the finger-object contacts at the end of closing that lie within "
     f"{IN_AREA_TOLERANCE_M * 1000:g} mm of a grasping-area point of the object's cloud "
     "(graspexp/report/contact_area.py; from each log's /contacts and /tf), over the trials whose fingers "
-    "touch the object then. Trials all in area %: share of those trials whose every contact is in the area."
+    "touch the object then. Trials all in area %: share of those trials whose every contact is in the area. "
+    "Success in area: successful trials whose every contact is in the area (the hand-over task's success)."
 )
 
 
@@ -259,9 +260,10 @@ def ranking(df: pd.DataFrame, dataset: str, settings: list[str]) -> pd.DataFrame
         touched = int(g["contacts"].sum())
         row["in-area contact %"] = f"{100 * g['contacts_in_area'].sum() / touched:.0f}" if touched else "n/a"
         held = g[g["contacts"] > 0]
-        row["trials all in area %"] = (
-            f"{100 * (held['contacts_in_area'] == held['contacts']).mean():.0f}" if len(held) else "n/a"
-        )
+        all_in = (held["contacts_in_area"] == held["contacts"]).mean() if len(held) else math.nan
+        row["trials all in area %"] = f"{100 * all_in:.0f}" if len(held) else "n/a"
+        in_area_success = g["success"] & (g["contacts"] > 0) & (g["contacts_in_area"] == g["contacts"])
+        row["success in area % [95% CI]"] = _success(g.assign(success=in_area_success))
         row[f"force-closure % (mu<={FC_MU:g})"] = (
             f"{100 * (planned['fc_min_mu'] <= FC_MU + 1e-9).mean():.0f}" if len(planned) else "n/a"
         )
