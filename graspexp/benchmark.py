@@ -21,7 +21,8 @@ entered; ``dataset=`` one dataset or several (``dataset=ycb,linemod``, the defau
 
 Output, one folder per planner, ``OUT/<planner>/``: ``runs/<dataset>/<mode>_<rot>_t<mm>_r<deg>/`` (the
 runner's job directories: resumable, locked, one MCAP log per trial), ``summary.md`` (ranking and tables),
-``ranking.csv``, ``noise.csv``, ``failures.csv`` and ``reproduce.json`` (command, every job's composed
+``ranking.csv``, ``trials.csv`` (per trial: outcome and in-area contact fraction), ``noise.csv``,
+``failures.csv`` and ``reproduce.json`` (command, every job's composed
 config, package versions, planner package and version). Re-running the same command resumes.
 """
 
@@ -51,6 +52,23 @@ from graspexp.report.render import display_frame, footnotes, markdown
 from graspexp.report.stats import percentiles, success_pct
 from graspexp.report.tables import failure_breakdown, success_table
 
+TRIAL_COLUMNS = (
+    "planner",
+    "dataset",
+    "mode",
+    "rot",
+    "trans_mm",
+    "rot_deg",
+    "object",
+    "trial",
+    "success",
+    "reason",
+    "contacts",
+    "contacts_in_area",
+    "fc_min_mu",
+    "plan_ms",
+)
+"""Columns of ``trials.csv``: one row per trial, with its in-area contact fraction beside its outcome."""
 NOISE_LEVELS: tuple[tuple[float, float], ...] = ((10.0, 0.0), (20.0, 0.0), (0.0, 10.0))
 """Pose-noise levels (translation std mm, rotation std degrees) run besides zero, as in ``nox -s compare``."""
 IN_AREA_NOTE = (
@@ -338,6 +356,10 @@ def write_summary(
             "",
         ]
         pd.concat(rankings).to_csv(out / "ranking.csv", index=False)
+        per_trial = df[[*TRIAL_COLUMNS]].assign(
+            in_area_fraction=(df["contacts_in_area"] / df["contacts"].where(df["contacts"] > 0))
+        )
+        per_trial.to_csv(out / "trials.csv", index=False)
         zero = df[(df["trans_mm"] == 0) & (df["rot_deg"] == 0)]
         for dataset in bench.datasets:
             if dataset in PAPER_TABLES and (zero["dataset"] == dataset).any():
