@@ -110,11 +110,6 @@ ABLATIONS: tuple[Reading, ...] = (
         (*PLUS, "planner.min_contacts_in_area=0"),
         "optimal_plus, pads may touch outside the area",
     ),
-    Reading(
-        "plus_no_area_margin",
-        (*PLUS, "planner.area_margin_m=0"),
-        "optimal_plus, contacts up to the area's border",
-    ),
     Reading("plus_n2048", (*PLUS, "planner.n_points=2048"), "optimal_plus with a 2048-point cloud"),
     Reading("plus_no_com", (*PLUS, "planner.com_weight=0"), "optimal_plus without the gravity-arm factor"),
     Reading(

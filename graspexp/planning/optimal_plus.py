@@ -17,8 +17,7 @@ is tried at several depths along its approach, and every try is checked as follo
    point moved along the approach by each offset; a try is kept only when both pads' contacts are
    centred at least ``min_pad_depth_m`` behind the fingertips, their surface normals lie inside the
    friction cone about the closing axis and at least ``min_contacts_in_area`` of each pad's contact
-   points are grasping-area points at least ``area_margin_m`` inside its border
-   (:func:`graspexp.planning.stability.pad_contacts`, :func:`~graspexp.planning.stability.eroded_area`). Per path the
+   points are grasping-area points (:func:`graspexp.planning.stability.pad_contacts`). Per path the
    first roll with a passing try is taken, and in it the try whose shallower pad depth reaches
    ``pad_depth_target_m`` with the smallest move (else the deepest).
 4. **Gravity arm** (``com_weight``): the path's cost is multiplied by ``1 + com_weight * a / D``, with
@@ -48,7 +47,6 @@ from graspexp.planning.optimal import paper_candidates
 from graspexp.planning.pose import grasp_rotations, opening_widths_m
 from graspexp.planning.request import PlanRequest, PlanResult
 from graspexp.planning.stability import (
-    eroded_area,
     gravity_arm_m,
     pad_contacts,
     pose_perturbations,
@@ -85,7 +83,6 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
     cand = paper_candidates(req, NAME, cluster_length_m=length)
     points, directions, centers = cand.points, cand.directions, cand.clusters.centers_m
     normals = np.asarray(req.normals, dtype=np.float64)
-    inner = eroded_area(points, cand.area_mask, pl.area_margin_m)
     k, m = cand.costs.shape
     com = volume_centroid_m(points)
     size = max(float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))), 1e-9)
@@ -117,7 +114,7 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
         held = np.zeros(len(placed.ok), dtype=bool)
         if placed.ok.any():
             held[placed.ok], depth[placed.ok] = _pads_hold(
-                pl, geometry, points, normals, inner, placed.poses[placed.ok]
+                pl, geometry, points, normals, cand.area_mask, placed.poses[placed.ok]
             )
         ok = placed.ok & held
         for key, n in placed.counts().items():
@@ -235,10 +232,9 @@ def _noise_pass(
         np.asarray(req.object_pose)[:3, 3],
     )
     normals = np.asarray(req.normals, dtype=np.float64)
-    inner = eroded_area(points, req.area_mask, pl.area_margin_m)
     ok = np.zeros(len(poses))
     for motion in motions:
         moved = points @ motion[:3, :3].T + motion[:3, 3]
         free = cloud_hits(moved, poses, req.gripper, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0) == 0
-        ok += free & _pads_hold(pl, geometry, moved, normals @ motion[:3, :3].T, inner, poses)[0]
+        ok += free & _pads_hold(pl, geometry, moved, normals @ motion[:3, :3].T, req.area_mask, poses)[0]
     return ok / len(motions)

@@ -21,7 +21,7 @@ axis, origin midway between the pads; the fingers span ``[root_z_m, tip_z_m]`` a
 """
 
 import numpy as np
-from scipy.spatial import ConvexHull, QhullError, cKDTree
+from scipy.spatial import ConvexHull, QhullError
 
 from graspexp.config.gripper import GripperGeometry
 from graspexp.geometry import axis_angle_matrix
@@ -42,18 +42,6 @@ def volume_centroid_m(points_m: np.ndarray) -> np.ndarray:
         return p.mean(axis=0)
     centres = (tri.sum(axis=1) + apex) / 4
     return (vol[:, None] * centres).sum(axis=0) / vol.sum()
-
-
-def eroded_area(points_m: np.ndarray, area_mask: np.ndarray, margin_m: float) -> np.ndarray:
-    """(N,) bool: the grasping-area points at least ``margin_m`` from every point outside the area (m);
-    ``area_mask`` (N,) itself where ``margin_m`` is 0 or every point is in the area."""
-    area = np.asarray(area_mask, dtype=bool)
-    if margin_m <= 0 or area.all() or not area.any():
-        return area.copy()
-    distance, _ = cKDTree(np.asarray(points_m)[~area]).query(np.asarray(points_m)[area])
-    out = np.zeros_like(area)
-    out[np.flatnonzero(area)] = distance >= margin_m
-    return out
 
 
 def gravity_arm_m(poses: np.ndarray, com_m: np.ndarray) -> np.ndarray:
