@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from graspexp.report.collect import collect
+from graspexp.report.collect import TRIAL_KEYS, collect
 from graspexp.report.paper import PAPER_TABLES, SETTINGS
 from graspexp.report.render import SHORT, fmt_ci, fmt_paper, fmt_pct, markdown
 from graspexp.report.tables import AVERAGE, AVERAGE_SAME, success_table
@@ -24,6 +24,8 @@ class MixedConfigError(ValueError):
 def _results(name: str, root: Path) -> pd.DataFrame:
     col = collect(root)
     df = col.results
+    if df.empty:  # run with record=false: no trial logs, the runner's results.csv of each job instead
+        df = _results_tables(name, root)
     if col.duplicates:
         raise MixedConfigError(
             f"reading {name!r}: {len(col.duplicates)} trials are logged twice below {root} "
@@ -32,6 +34,22 @@ def _results(name: str, root: Path) -> pd.DataFrame:
     if not df.empty and df["planner"].nunique() > 1:
         raise MixedConfigError(
             f"reading {name!r}: {root} holds planners {sorted(df['planner'].unique())}: one directory per reading"
+        )
+    return df
+
+
+def _results_tables(name: str, root: Path) -> pd.DataFrame:
+    """Every ``results.csv`` below ``root`` in one frame (empty when there is none); a trial listed twice
+    is refused as for logs."""
+    tables = [pd.read_csv(p) for p in sorted(Path(root).rglob("results.csv"))]
+    if not tables:
+        return pd.DataFrame()
+    df = pd.concat(tables, ignore_index=True)
+    df["success"] = df["success"].astype(bool)
+    if df.duplicated(list(TRIAL_KEYS)).any():
+        raise MixedConfigError(
+            f"reading {name!r}: trials are listed twice in the results.csv files below {root}: one "
+            "directory must hold one config"
         )
     return df
 
