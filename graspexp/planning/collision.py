@@ -30,9 +30,6 @@ from graspexp.config.gripper import GripperGeometry
 from graspexp.planning.kernels import swept_box_hits
 from graspexp.planning.pose import slab_spans_m
 
-POSE_BATCH = 128
-"""Poses per block when :func:`place_grasps` centres grasps on their sections."""
-
 
 def lowest_z(poses: np.ndarray, gripper: GripperConfig, widths_m: np.ndarray, sweep_m: float) -> np.ndarray:
     """Lowest world z reached by any gripper box during the approach, for a batch of grasps.
@@ -53,13 +50,6 @@ def lowest_z(poses: np.ndarray, gripper: GripperConfig, widths_m: np.ndarray, sw
     r = poses[:, 2, :3][:, None, None, :]  # (B, 1, 1, 3): row z of each rotation
     reach = (r * boxes).min(axis=2).sum(axis=-1)  # (B, 3) per box
     return poses[:, 2, 3] + reach.min(axis=1)
-
-
-def local_coords(points_m: np.ndarray, poses: np.ndarray) -> np.ndarray:
-    """(B, N, 3) coordinates of world points (N, 3) in each grasp frame of (B, 4, 4) poses."""
-    p = np.asarray(points_m, dtype=np.float64)
-    poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)
-    return (p[None, :, :] - poses[:, None, :3, 3]) @ poses[:, :3, :3]
 
 
 def cloud_hits(
@@ -202,13 +192,9 @@ def place_grasps(
 
     def centre_and_open(ps: np.ndarray, fl: np.ndarray) -> np.ndarray:
         """Shift each pose along its +Y to the middle of its section (in place); return the openings."""
-        out = np.empty(len(ps))
-        for s in range(0, len(ps), POSE_BATCH):
-            blk = ps[s : s + POSE_BATCH]
-            spans = slab_spans_m(points_m, blk[:, :3, 3], blk[:, :3, :3], gripper, margin_m)
-            blk[:, :3, 3] += spans.mean(axis=1)[:, None] * blk[:, :3, 1]
-            out[s : s + POSE_BATCH] = spans[:, 1] - spans[:, 0]
-        return np.maximum(out + 2.0 * clearance_m, fl)
+        spans = slab_spans_m(points_m, ps[:, :3, 3], ps[:, :3, :3], gripper, margin_m)
+        ps[:, :3, 3] += spans.mean(axis=1)[:, None] * ps[:, :3, 1]
+        return np.maximum(spans[:, 1] - spans[:, 0] + 2.0 * clearance_m, fl)
 
     widths = centre_and_open(poses, floor)
     lift = support_lift_m(

@@ -40,6 +40,7 @@ paper's, inf where removed by the plane test), ``best``, ``pose``, ``width``) pl
 import numpy as np
 
 from graspexp.config.gripper import GripperGeometry
+from graspexp.geometry import transform_points
 from graspexp.planning.collision import cloud_hits, place_for_request
 from graspexp.planning.friction import cone_cosine
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
@@ -86,8 +87,9 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
     k, m = cand.costs.shape
     com = volume_centroid_m(points)
     size = max(float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))), 1e-9)
-    floors = opening_widths_m(cand.clusters.radii_m, pl.width_margin, gr)  # (K,) m, the paper's 2 r_k rule
-    if pl.opening == "section":
+    if pl.opening == "cluster":  # (K,) smallest openings, m: the paper's 2 r_k rule
+        floors = opening_widths_m(cand.clusters.radii_m, pl.width_margin, gr)
+    else:
         floors = np.zeros(k)
     offsets = np.asarray(pl.depth_offsets_m, dtype=np.float64)
     rolls = [_roll(np.deg2rad(r)) for r in pl.rolls_deg]
@@ -212,7 +214,9 @@ def _pads_hold(
 
 
 def _roll(angle_rad: float) -> np.ndarray:
-    """(3, 3) rotation of a grasp frame about its own approach axis +Z by ``angle_rad``."""
+    """(3, 3) rotation of a grasp frame about its own approach axis +Z by ``angle_rad``. Written out, not
+    :func:`graspexp.geometry.yaw_rotation`: its Rodrigues form leaves cos(90 deg) = 0 where this keeps
+    6e-17, and the benchmark's grasps were planned with this one."""
     c, s = np.cos(angle_rad), np.sin(angle_rad)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
@@ -234,7 +238,7 @@ def _noise_pass(
     normals = np.asarray(req.normals, dtype=np.float64)
     ok = np.zeros(len(poses))
     for motion in motions:
-        moved = points @ motion[:3, :3].T + motion[:3, 3]
+        moved = transform_points(motion, points)
         free = cloud_hits(moved, poses, req.gripper, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0) == 0
         ok += free & _pads_hold(pl, geometry, moved, normals @ motion[:3, :3].T, req.area_mask, poses)[0]
     return ok / len(motions)

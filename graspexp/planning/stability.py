@@ -92,16 +92,23 @@ def pad_contacts(
     return stats[:, 0], stats[:, 1], stats[:, 2]
 
 
+def pose_error(rng: np.random.Generator, trans_mm: float, rot_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    """One draw of the pose estimator's error: (3, 3) rotation about a random axis by a Gaussian angle
+    (std ``rot_deg``) and (3,) Gaussian translation (std ``trans_mm`` per axis), m. The one error model of
+    the simulated perception (:func:`graspexp.sim.trial.perceived_pose`) and of the planner's noise check."""
+    rotation = axis_angle_matrix(rng.normal(size=3), np.deg2rad(rng.normal(0.0, rot_deg)))
+    return rotation, rng.normal(0.0, trans_mm, size=3) / 1000.0
+
+
 def pose_perturbations(
     rng: np.random.Generator, n: int, trans_mm: float, rot_deg: float, origin_m: np.ndarray
 ) -> np.ndarray:
-    """(n, 4, 4) world rigid motions drawn like :func:`graspexp.sim.trial.perceived_pose`'s error:
-    a rotation about a random axis by a Gaussian angle (std ``rot_deg``) about ``origin_m`` (the
-    object's origin, world, m), then a Gaussian translation (std ``trans_mm`` per axis)."""
+    """(n, 4, 4) world rigid motions of :func:`pose_error` draws, each rotating about ``origin_m`` (the
+    object's origin, world, m) and then translating."""
     out = np.tile(np.eye(4), (n, 1, 1))
     origin = np.asarray(origin_m, dtype=np.float64)
     for i in range(n):
-        rot = axis_angle_matrix(rng.normal(size=3), np.deg2rad(rng.normal(0.0, rot_deg)))
+        rot, trans = pose_error(rng, trans_mm, rot_deg)
         out[i, :3, :3] = rot
-        out[i, :3, 3] = origin - rot @ origin + rng.normal(0.0, trans_mm, size=3) / 1000.0
+        out[i, :3, 3] = origin - rot @ origin + trans
     return out

@@ -19,10 +19,11 @@ from omegaconf import DictConfig, OmegaConf
 
 from graspexp.config import JobConfig
 from graspexp.datasets.model import ObjectModel
-from graspexp.geometry import axis_angle_matrix, make_pose, random_rotation, transform_points, yaw_rotation
+from graspexp.geometry import make_pose, random_rotation, transform_points, yaw_rotation
 from graspexp.outcome import FailureReason, TrialResult
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.request import PlanRequest, PlanResult
+from graspexp.planning.stability import pose_error
 from graspexp.seeding import plan_seed, rng_for
 from graspexp.sim.contacts import SupportTouch, contact_records, finger_forces
 from graspexp.sim.gripper import FINGER_NAMES, Gripper, build_gripper
@@ -133,11 +134,10 @@ def perceived_pose(
     by a Gaussian angle (std ``rot_deg``) about the object's origin. Zero noise returns the pose unchanged."""
     if trans_mm == 0 and rot_deg == 0:
         return true_pose.copy()
-    axis = rng.normal(size=3)
-    dR = axis_angle_matrix(axis, np.deg2rad(rng.normal(0.0, rot_deg)))
+    dR, trans = pose_error(rng, trans_mm, rot_deg)
     out = true_pose.copy()
     out[:3, :3] = dR @ true_pose[:3, :3]
-    out[:3, 3] += rng.normal(0.0, trans_mm, size=3) / 1000.0
+    out[:3, 3] += trans
     return out
 
 
