@@ -170,3 +170,22 @@ def test_empty_lists_are_one_clear_error(key: str) -> None:
     pts, normals = _cloud(trimesh.creation.box((0.05, 0.05, 0.05)), n=500)
     with pytest.raises(ValueError, match=f"planner.{key} is empty: give at least one value"):
         plan(_request(pts, normals, **{key: []}))
+
+
+def test_area_fallback_takes_the_grasp_touching_the_area_most() -> None:
+    """A band of the box narrower than a pad is its area: no pad lies wholly in it, so only the fallback
+    plans, and it requires the best share any try reached."""
+    box = trimesh.creation.box((0.09, 0.06, 0.04))
+    pts, normals = _cloud(box, n=3000)
+    area = np.abs(pts[:, 0]) < 0.004
+    with pytest.raises(NoFeasibleGrasp, match="in the grasping area") as strict:
+        plan(_request(pts, normals, area, fallback_contacts_in_area=1.0))
+    best = float(str(strict.value).split("best passing try: ")[1].split(",")[0])
+    assert 0.0 < best < 1.0
+    g = plan(_request(pts, normals, area, fallback_contacts_in_area=0.0)).grasp
+    assert g.extras["in_area_required"] == pytest.approx(best, abs=0.005)
+    assert abs(g.position[0]) < 0.01  # the pads straddle the band
+    with pytest.raises(NoFeasibleGrasp, match="below fallback_contacts_in_area"):
+        plan(_request(pts, normals, area, fallback_contacts_in_area=min(best + 0.05, 1.0)))
+    whole = plan(_request(pts, normals, fallback_contacts_in_area=0.0)).grasp  # the whole box is area
+    assert whole.extras["in_area_required"] == 1.0

@@ -29,10 +29,15 @@ is tried at several depths along its approach, and every try is checked as follo
    origin; the paths passing in at least ``noise_min_pass`` of them (else those passing most often)
    compete on the cost of 4.
 
+6. **Area fallback** (``fallback_contacts_in_area``): when no path passes 1-3, the search is repeated
+   requiring only the largest in-area share any try reached (the grasp touching the area most), if that
+   share is at least ``fallback_contacts_in_area``; ``extras["in_area_required"]`` records the share
+   required (``min_contacts_in_area`` when no fallback was needed).
+
 Examination stops once ``shortlist`` paths pass 1-3. ``Grasp.n_feasible`` counts them; ``extras`` holds
 ``K``, ``M``, ``n_examined``, the rejections (``n_too_wide``, ``n_below_support``, ``n_collides``,
-``n_weak_contact``), ``pad_depth_m``, ``gravity_arm_m``, ``depth_offset_m``, ``noise_pass`` and
-``com_factor``. ``details`` holds the same keys as ``optimal`` where they apply (``cloud``,
+``n_weak_contact``, ``n_outside_area``), ``in_area_required``, ``pad_depth_m``, ``gravity_arm_m``,
+``depth_offset_m``, ``noise_pass`` and ``com_factor``. ``details`` holds the same keys as ``optimal`` where they apply (``cloud``,
 ``area_mask``, ``labels``, ``centers``, ``radii``, ``main_axis``, ``directions``, ``costs`` (K, M; the
 paper's, inf where removed by the plane test), ``best``, ``pose``, ``width``) plus ``com`` (3,).
 """
@@ -82,8 +87,7 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
     geometry = GripperGeometry.of(gr)
     length = geometry.finger_width_m if pl.cluster_length == "finger_width" else None
     cand = paper_candidates(req, NAME, cluster_length_m=length)
-    points, directions, centers = cand.points, cand.directions, cand.clusters.centers_m
-    normals = np.asarray(req.normals, dtype=np.float64)
+    points = cand.points
     k, m = cand.costs.shape
     com = volume_centroid_m(points)
     size = max(float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))), 1e-9)
@@ -91,15 +95,94 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
         floors = opening_widths_m(cand.clusters.radii_m, pl.width_margin, gr)
     else:
         floors = np.zeros(k)
+    passed, rejected, examined, best_share = _search_paths(
+        req, cand, geometry, floors, pl.min_contacts_in_area
+    )
+    in_area_required = pl.min_contacts_in_area
+    if not passed and pl.fallback_contacts_in_area <= best_share < pl.min_contacts_in_area:
+        # step 6 of the module doc: the tries touching the area most
+        in_area_required = best_share
+        passed = _search_paths(req, cand, geometry, floors, best_share)[0]
+    if not passed:
+        raise NoFeasibleGrasp(
+            f"optimal_plus: all {examined} paths above the support failed at every depth: "
+            f"{rejected['n_too_wide']} tries too wide for the stroke {gr.max_width_m} m, "
+            f"{rejected['n_below_support']} below the support, {rejected['n_collides']} colliding with the "
+            f"cloud, {rejected['n_weak_contact']} with a pad contact shallower than {pl.min_pad_depth_m} m "
+            f"or outside the friction cone, {rejected['n_outside_area']} with less than "
+            f"{pl.min_contacts_in_area} of a pad's contact in the grasping area (the best passing try: "
+            f"{best_share:.2f}, below fallback_contacts_in_area {pl.fallback_contacts_in_area})"
+        )
+    passed = passed[: pl.shortlist]
+    poses = np.stack([p[2] for p in passed])
+    widths = np.array([p[3] for p in passed])
+    arms = gravity_arm_m(poses, com)
+    factors = 1.0 + pl.com_weight * arms / size
+    costs = np.array([cand.costs[p[0], p[1]] for p in passed]) * factors
+    noise_pass = _noise_pass(req, points, poses, widths, geometry, in_area_required)
+    robust = noise_pass >= min(pl.noise_min_pass, noise_pass.max())
+    j = int(np.argmin(np.where(robust, costs, np.inf)))
+    kb, pb, pose, width, depth, offset, roll_deg = passed[j]
+    grasp = Grasp(
+        pose=pose,
+        width_m=width,
+        cost=float(costs[j]),
+        cluster=kb,
+        path=pb,
+        n_feasible=len(passed),
+        planner=NAME,
+        extras={
+            "K": k,
+            "M": m,
+            "n_examined": examined,
+            **rejected,
+            "in_area_required": float(in_area_required),
+            "pad_depth_m": depth,
+            "depth_offset_m": offset,
+            "roll_deg": roll_deg,
+            "gravity_arm_m": float(arms[j]),
+            "com_factor": float(factors[j]),
+            "noise_pass": float(noise_pass[j]),
+        },
+    )
+    details = {
+        "cloud": points,
+        "area_mask": cand.area_mask,
+        "labels": cand.clusters.labels,
+        "centers": cand.clusters.centers_m,
+        "radii": cand.clusters.radii_m,
+        "main_axis": cand.axis,
+        "directions": cand.directions,
+        "costs": cand.costs,
+        "com": com,
+        "best": np.array([kb, pb]),
+        "pose": pose,
+        "width": np.float64(width),
+    }
+    return PlanResult(grasp=grasp, details=details)
+
+
+def _search_paths(
+    req: PlanRequest, cand, geometry: GripperGeometry, floors: np.ndarray, min_share: float
+) -> tuple[list[tuple], dict[str, int], int, float]:
+    """Steps 1-3 of the module doc over the paper's paths in ascending cost, requiring ``min_share`` of
+    each pad's contact in the area: the passing paths ``(k, p, pose, width, depth, offset, roll_deg)``
+    (up to ``shortlist``), the rejection counts, the number of paths examined and the largest in-area
+    share among the tries that pass everything but the area test (0 if none)."""
+    pl = req.planner
+    points, directions, centers = cand.points, cand.directions, cand.clusters.centers_m
+    normals = np.asarray(req.normals, dtype=np.float64)
+    k, m = cand.costs.shape
     offsets = np.asarray(pl.depth_offsets_m, dtype=np.float64)
     rolls = [_roll(np.deg2rad(r)) for r in pl.rolls_deg]
     n_roll, n_off = len(rolls), len(offsets)
     by_offset = np.argsort(np.abs(offsets), kind="stable")  # tie-break: the smallest move
-
     order = np.argsort(cand.costs, axis=None, kind="stable")[: int(cand.feasible.sum())]
-    rejected = {"n_too_wide": 0, "n_below_support": 0, "n_collides": 0, "n_weak_contact": 0}
-    passed: list[tuple] = []  # (k, p, pose, width, depth, offset, roll_deg)
-    examined = 0
+    rejected = dict.fromkeys(
+        ("n_too_wide", "n_below_support", "n_collides", "n_weak_contact", "n_outside_area"), 0
+    )
+    passed: list[tuple] = []
+    examined, best_share = 0, 0.0
     for s in range(0, len(order), PATH_BATCH):
         ks, ps = np.unravel_index(order[s : s + PATH_BATCH], (k, m))
         examined += len(ks)
@@ -114,14 +197,19 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
         placed = place_for_request(req, poses.reshape(-1, 4, 4), np.repeat(floors[ks], n_roll * n_off))
         depth = np.full(len(placed.ok), -np.inf)
         held = np.zeros(len(placed.ok), dtype=bool)
+        share = np.zeros(len(placed.ok))
         if placed.ok.any():
-            held[placed.ok], depth[placed.ok] = _pads_hold(
+            held[placed.ok], depth[placed.ok], share[placed.ok] = _pads_hold(
                 pl, geometry, points, normals, cand.area_mask, placed.poses[placed.ok]
             )
-        ok = placed.ok & held
+        held &= placed.ok
+        ok = held & (share >= min_share)
         for key, n in placed.counts().items():
             rejected[key] += n
-        rejected["n_weak_contact"] += int((placed.ok & ~ok).sum())
+        rejected["n_weak_contact"] += int((placed.ok & ~held).sum())
+        rejected["n_outside_area"] += int((held & ~ok).sum())
+        if held.any():
+            best_share = max(best_share, float(share[held].max()))
         ok, depth = ok.reshape(b, n_roll, n_off), depth.reshape(b, n_roll, n_off)
         # per path: the first roll with a passing try, then the target depth with the smallest move
         for i in np.flatnonzero(ok.any(axis=(1, 2))):
@@ -142,59 +230,7 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
             )
         if len(passed) >= pl.shortlist:
             break
-    if not passed:
-        raise NoFeasibleGrasp(
-            f"optimal_plus: all {examined} paths above the support failed at every depth: "
-            f"{rejected['n_too_wide']} tries too wide for the stroke {gr.max_width_m} m, "
-            f"{rejected['n_below_support']} below the support, {rejected['n_collides']} colliding with the "
-            f"cloud, {rejected['n_weak_contact']} with a pad contact shallower than {pl.min_pad_depth_m} m, outside the friction cone or outside the grasping area"
-        )
-    passed = passed[: pl.shortlist]
-    poses = np.stack([p[2] for p in passed])
-    widths = np.array([p[3] for p in passed])
-    arms = gravity_arm_m(poses, com)
-    factors = 1.0 + pl.com_weight * arms / size
-    costs = np.array([cand.costs[p[0], p[1]] for p in passed]) * factors
-    noise_pass = _noise_pass(req, points, poses, widths, geometry)
-    robust = noise_pass >= min(pl.noise_min_pass, noise_pass.max())
-    j = int(np.argmin(np.where(robust, costs, np.inf)))
-    kb, pb, pose, width, depth, offset, roll_deg = passed[j]
-    grasp = Grasp(
-        pose=pose,
-        width_m=width,
-        cost=float(costs[j]),
-        cluster=kb,
-        path=pb,
-        n_feasible=len(passed),
-        planner=NAME,
-        extras={
-            "K": k,
-            "M": m,
-            "n_examined": examined,
-            **rejected,
-            "pad_depth_m": depth,
-            "depth_offset_m": offset,
-            "roll_deg": roll_deg,
-            "gravity_arm_m": float(arms[j]),
-            "com_factor": float(factors[j]),
-            "noise_pass": float(noise_pass[j]),
-        },
-    )
-    details = {
-        "cloud": points,
-        "area_mask": cand.area_mask,
-        "labels": cand.clusters.labels,
-        "centers": centers,
-        "radii": cand.clusters.radii_m,
-        "main_axis": cand.axis,
-        "directions": directions,
-        "costs": cand.costs,
-        "com": com,
-        "best": np.array([kb, pb]),
-        "pose": pose,
-        "width": np.float64(width),
-    }
-    return PlanResult(grasp=grasp, details=details)
+    return passed[: pl.shortlist], rejected, examined, best_share
 
 
 def _pads_hold(
@@ -204,13 +240,13 @@ def _pads_hold(
     normals: np.ndarray,
     area_mask: np.ndarray,
     poses: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Step 3 of the module doc for (B, 4, 4) poses: (B,) whether both pads' contacts are at least
-    ``min_pad_depth_m`` deep, inside the friction cone of ``friction_coef`` and at least
-    ``min_contacts_in_area`` in the grasping area, and (B,) the depth, m."""
+    ``min_pad_depth_m`` deep and inside the friction cone of ``friction_coef``, (B,) the depth, m, and
+    (B,) the smaller of the two pads' shares of contact points in the grasping area."""
     depth, angle, share = pad_contacts(points, normals, poses, geometry, pl.contact_band_m, area_mask)
     ok = (depth >= pl.min_pad_depth_m) & (np.cos(angle) >= cone_cosine(pl.friction_coef))
-    return ok & (share >= pl.min_contacts_in_area), depth
+    return ok, depth, share
 
 
 def _roll(angle_rad: float) -> np.ndarray:
@@ -222,9 +258,15 @@ def _roll(angle_rad: float) -> np.ndarray:
 
 
 def _noise_pass(
-    req: PlanRequest, points: np.ndarray, poses: np.ndarray, widths: np.ndarray, geometry: GripperGeometry
+    req: PlanRequest,
+    points: np.ndarray,
+    poses: np.ndarray,
+    widths: np.ndarray,
+    geometry: GripperGeometry,
+    min_share: float,
 ) -> np.ndarray:
-    """(B,) share of the pose-noise draws (module doc, step 5) under which each grasp still passes."""
+    """(B,) share of the pose-noise draws (module doc, step 5) under which each grasp still passes, with
+    ``min_share`` of each pad's contact in the area."""
     pl = req.planner
     if pl.noise_samples == 0 or (pl.noise_trans_mm == 0 and pl.noise_rot_deg == 0):
         return np.ones(len(poses))
@@ -240,5 +282,6 @@ def _noise_pass(
     for motion in motions:
         moved = transform_points(motion, points)
         free = cloud_hits(moved, poses, req.gripper, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0) == 0
-        ok += free & _pads_hold(pl, geometry, moved, normals @ motion[:3, :3].T, req.area_mask, poses)[0]
+        held, _, share = _pads_hold(pl, geometry, moved, normals @ motion[:3, :3].T, req.area_mask, poses)
+        ok += free & held & (share >= min_share)
     return ok / len(motions)
