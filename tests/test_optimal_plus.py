@@ -13,11 +13,11 @@ from graspexp.planning import NoFeasibleGrasp, PlanRequest, plan
 from graspexp.planning.stability import gravity_arm_m, pad_contacts, pose_perturbations, volume_centroid_m
 
 
-def _request(pts, normals, area=None, seed: int = 3, **planner) -> PlanRequest:
+def _request(pts, normals, area=None, seed: int = 3, mode: str = "bin", **planner) -> PlanRequest:
     cfg = _cfg("optimal_plus")
     pl = dataclasses.replace(cfg.planner, **planner)
     mask = np.ones(len(pts), bool) if area is None else area
-    return PlanRequest(pts, normals, mask, np.eye(4), TABLE_Z, "bin", cfg.gripper, pl, cfg.cost, seed)
+    return PlanRequest(pts, normals, mask, np.eye(4), TABLE_Z, mode, cfg.gripper, pl, cfg.cost, seed)
 
 
 def _geometry() -> GripperGeometry:
@@ -180,12 +180,14 @@ def test_area_fallback_takes_the_grasp_touching_the_area_most() -> None:
     area = np.abs(pts[:, 0]) < 0.004
     with pytest.raises(NoFeasibleGrasp, match="in the grasping area") as strict:
         plan(_request(pts, normals, area, fallback_contacts_in_area=1.0))
-    best = float(str(strict.value).split("best passing try: ")[1].split(",")[0])
+    best = float(str(strict.value).split("best passing try: ")[1].split(";")[0])
     assert 0.0 < best < 1.0
     g = plan(_request(pts, normals, area, fallback_contacts_in_area=0.0)).grasp
     assert g.extras["in_area_required"] == pytest.approx(best, abs=0.005)
     assert abs(g.position[0]) < 0.01  # the pads straddle the band
-    with pytest.raises(NoFeasibleGrasp, match="below fallback_contacts_in_area"):
-        plan(_request(pts, normals, area, fallback_contacts_in_area=min(best + 0.05, 1.0)))
+    with pytest.raises(NoFeasibleGrasp, match="fallback_contacts_in_area 0.9"):
+        plan(_request(pts, normals, area, fallback_contacts_in_area=0.9))  # above the best share
+    with pytest.raises(NoFeasibleGrasp, match=r"in the modes \['bin'\], this is collab"):
+        plan(_request(pts, normals, area, mode="collab"))  # a person holds the rest: no fallback
     whole = plan(_request(pts, normals, fallback_contacts_in_area=0.0)).grasp  # the whole box is area
     assert whole.extras["in_area_required"] == 1.0

@@ -29,10 +29,11 @@ is tried at several depths along its approach, and every try is checked as follo
    origin; the paths passing in at least ``noise_min_pass`` of them (else those passing most often)
    compete on the cost of 4.
 
-6. **Area fallback** (``fallback_contacts_in_area``): when no path passes 1-3, the search is repeated
-   requiring only the largest in-area share any try reached (the grasp touching the area most), if that
-   share is at least ``fallback_contacts_in_area``; ``extras["in_area_required"]`` records the share
-   required (``min_contacts_in_area`` when no fallback was needed).
+6. **Area fallback** (``fallback_contacts_in_area``, ``fallback_modes``): in the modes listed, when no
+   path passes 1-3, the search is repeated requiring only the largest in-area share any try reached
+   (the grasp touching the area most), if that share is at least ``fallback_contacts_in_area``;
+   ``extras["in_area_required"]`` records the share required (``min_contacts_in_area`` when no
+   fallback was needed).
 
 Examination stops once ``shortlist`` paths pass 1-3. ``Grasp.n_feasible`` counts them; ``extras`` holds
 ``K``, ``M``, ``n_examined``, the rejections (``n_too_wide``, ``n_below_support``, ``n_collides``,
@@ -99,7 +100,8 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
         req, cand, geometry, floors, pl.min_contacts_in_area
     )
     in_area_required = pl.min_contacts_in_area
-    if not passed and pl.fallback_contacts_in_area <= best_share < pl.min_contacts_in_area:
+    fallback = req.mode in pl.fallback_modes and pl.fallback_contacts_in_area <= best_share
+    if not passed and fallback and best_share < pl.min_contacts_in_area:
         # step 6 of the module doc: the tries touching the area most
         in_area_required = best_share
         passed = _search_paths(req, cand, geometry, floors, best_share)[0]
@@ -111,7 +113,8 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
             f"cloud, {rejected['n_weak_contact']} with a pad contact shallower than {pl.min_pad_depth_m} m "
             f"or outside the friction cone, {rejected['n_outside_area']} with less than "
             f"{pl.min_contacts_in_area} of a pad's contact in the grasping area (the best passing try: "
-            f"{best_share:.2f}, below fallback_contacts_in_area {pl.fallback_contacts_in_area})"
+            f"{best_share:.2f}; fallback_contacts_in_area {pl.fallback_contacts_in_area} in the modes "
+            f"{list(pl.fallback_modes)}, this is {req.mode})"
         )
     passed = passed[: pl.shortlist]
     poses = np.stack([p[2] for p in passed])

@@ -57,13 +57,18 @@ class OptimalPlusConfig(PaperPathsConfig, OpeningConfig):
     """Share of each pad's contact points that must be grasping-area points (III-A: the robot grasps
     the area, not the part a person holds). The grasp point is aimed inside the area, but fingers 8 cm
     long can close on another part first (the iron's handle above its body)."""
-    fallback_contacts_in_area: float = 0.5
-    """When no path passes with ``min_contacts_in_area``, the search is repeated requiring the largest
-    share any try reached, if at least this (1.0: no fallback; ``extras["in_area_required"]`` records
-    it). Some poses leave no grasp inside the area: the cat on its side closes on its legs or head
-    whatever the path, the iron on its side meets the soleplate. 0.5: each pad still touches mostly
-    area, so a person holding the other part is touched by at most the edge of a pad; the in-area
-    metric reports every such trial."""
+    fallback_contacts_in_area: float = 0.0
+    """In the modes of ``fallback_modes``, when no path passes with ``min_contacts_in_area``, the search
+    is repeated requiring the largest share any try reached, if at least this (1.0: no fallback;
+    ``extras["in_area_required"]`` records the share required). Some poses leave no grasp inside the
+    area: the cat on its side closes on its legs or head whatever the path (the best try's share is
+    0-0.14), the iron on its side on the soleplate or the handle. 0: the grasp touching the area most,
+    rather than none; the in-area metric reports every such trial."""
+    fallback_modes: list[str] = field(default_factory=lambda: ["bin"])
+    """Modes in which the fallback applies. ``bin``: nobody holds the object, the area is the task's
+    preference (III-A), and a pick outside it beats no pick. Not ``collab``: there a person holds the
+    rest of the object (IV-C, hand-over), so a grasp outside the area would take their hand; none is
+    planned."""
     contact_band_m: float = 0.004
     """Points within this of a side's extreme y count as that pad's contacts, m: about the cloud's point
     spacing (2048 points on a Table 1 object)."""
@@ -97,6 +102,7 @@ CONSTRAINTS = {
     "friction_coef": [Interval(0, 10, "right")],
     "min_contacts_in_area": [Interval(0, 1)],
     "fallback_contacts_in_area": [Interval(0, 1)],
+    "fallback_modes": [Vector(None, Options(("collab", "bin")))],
     "contact_band_m": [Interval(0, 0.05, "right", "m")],
     "com_weight": [Interval(0, 100)],
     "shortlist": [Interval(1, 100_000, integer=True)],
