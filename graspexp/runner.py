@@ -32,7 +32,7 @@ from omegaconf import DictConfig, OmegaConf
 from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
-from graspexp.config import validate
+from graspexp.config import BEFORE, validate
 from graspexp.datasets import job_object, select_objects
 from graspexp.datasets.model import ObjectModel
 from graspexp.outcome import FailureReason, TrialResult
@@ -211,12 +211,16 @@ def _neutral(key: str) -> bool:
 _NO_DEFAULT = object()
 
 
-def _schema_default(cfg: DictConfig, key: str) -> object:
-    """The default that the schema of dotted ``key``'s node in ``cfg`` gives it, else ``_NO_DEFAULT``."""
+def _value_before(cfg: DictConfig, key: str) -> object:
+    """The value dotted ``key`` had before graspexp added it: its schema field's ``metadata["before"]``
+    (:data:`graspexp.config.BEFORE`) when the key came with a new behaviour, else its default; else
+    ``_NO_DEFAULT``."""
     parent, _, leaf = key.rpartition(".")
     node = OmegaConf.select(cfg, parent) if parent else cfg
     schema = OmegaConf.get_type(node) if isinstance(node, DictConfig) else None
     for f in dataclasses.fields(schema) if dataclasses.is_dataclass(schema) else ():
+        if f.name == leaf and BEFORE in f.metadata:
+            return f.metadata[BEFORE]
         if f.name == leaf and f.default is not dataclasses.MISSING:
             return f.default
     return _NO_DEFAULT
@@ -224,8 +228,8 @@ def _schema_default(cfg: DictConfig, key: str) -> object:
 
 def config_differences(recorded_yaml: str, cfg: DictConfig) -> dict[str, tuple[object, object]]:
     """dotted key -> (value in the log, value now) for every key that affects a result and differs; a key
-    absent on one side shows as ``<absent>``. A key the log lacks that now has its schema's default is not
-    a difference: it was added to graspexp after the log was written, with the value the code had before."""
+    absent on one side shows as ``<absent>``. A key the log lacks is not a difference when it now has the
+    value the code had before the key was added (:func:`_value_before`)."""
     old = _flatten(OmegaConf.to_container(OmegaConf.create(recorded_yaml), resolve=True))
     new = _flatten(OmegaConf.to_container(cfg, resolve=True))
     absent = "<absent>"
@@ -234,7 +238,7 @@ def config_differences(recorded_yaml: str, cfg: DictConfig) -> dict[str, tuple[o
         for k in sorted(old.keys() | new.keys())
         if not _neutral(k)
         and old.get(k, absent) != new.get(k, absent)
-        and not (k not in old and k in new and new[k] == _schema_default(cfg, k))
+        and not (k not in old and k in new and new[k] == _value_before(cfg, k))
     }
 
 

@@ -95,6 +95,15 @@ def test_a_key_added_since_the_log_counts_as_equal_only_at_its_default() -> None
     }
 
 
+def test_a_key_added_with_a_new_behaviour_counts_as_its_value_before() -> None:
+    """``sim.settle_hold_s`` came with a longer settle (0.1 s); logs without it settled in one step (0)."""
+    recorded = OmegaConf.create(job_metadata(compose_cfg(*BASE))["config_yaml"])
+    del recorded.sim["settle_hold_s"]
+    old_log = OmegaConf.to_yaml(recorded)
+    assert config_differences(old_log, compose_cfg(*BASE)) == {"sim.settle_hold_s": ("<absent>", 0.1)}
+    assert config_differences(old_log, compose_cfg(*BASE, "sim.settle_hold_s=0")) == {}
+
+
 @pytest.mark.parametrize(
     ("overrides", "message"),
     [

@@ -5,6 +5,7 @@ Every YAML option under ``conf/<group>/`` lists its schema (``/schema_<group>@_h
 every option and rejects unknown keys. The schemas are stored outside the groups, so none is an option. Nothing here imports Hydra (only :func:`register_configs` does, when called).
 """
 
+from graspexp.config.constraints import BEFORE, added
 from graspexp.config.cost import CostConfig
 from graspexp.config.dataset import DatasetConfig
 from graspexp.config.gripper import GripperConfig
@@ -26,6 +27,8 @@ from graspexp.config.sim import SimConfig
 from graspexp.config.validate import ConfigError, validate
 
 __all__ = [
+    "BEFORE",
+    "added",
     "BASE_CONSTRAINTS",
     "AntipodalConfig",
     "ObbConfig",

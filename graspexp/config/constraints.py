@@ -9,7 +9,17 @@ that the error message prints.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
+
+BEFORE = "before"
+"""Metadata key of a schema field that came with a new behaviour: the value the code had before the
+field existed. Resume compares a log written before then against it (graspexp/runner.py)."""
+
+
+def added(default: object, before: object) -> Any:
+    """A schema field with ``default`` that was added to graspexp after runs had behaved as ``before``."""
+    return field(default=default, metadata={BEFORE: before})
 
 
 def _is_int(v: object) -> bool:

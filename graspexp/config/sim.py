@@ -2,7 +2,7 @@
 
 from dataclasses import dataclass
 
-from graspexp.config.constraints import BOOL, TEXT, Interval, Options
+from graspexp.config.constraints import BOOL, TEXT, Interval, Options, added
 
 
 @dataclass
@@ -27,6 +27,10 @@ class SimConfig:
     """Object counts as settled below this linear speed, m/s."""
     settle_angular_radps: float = 0.05
     """... and below this angular speed, rad/s."""
+    settle_hold_s: float = added(0.1, before=0.0)
+    """... for this long without a break, s (0: one step). A rocking object passes both speeds at each
+    turn for a step or two: with one step, a bleach cleanser lying on its side counted as settled at
+    such a turn and rolled back 4 cm into the closing fingers (YCB bin XYZ trial 6)."""
     max_redrops: int = 5
     """Re-drops allowed when the object falls off the support."""
     approach_speed_mps: float = 0.25
@@ -113,6 +117,7 @@ CONSTRAINTS = {
     "settle_min_s": [Interval(0, 60, unit="s")],
     "settle_linear_mps": [Interval(0, 1, "right", "m/s")],
     "settle_angular_radps": [Interval(0, 10, "right", "rad/s")],
+    "settle_hold_s": [Interval(0, 10, unit="s")],
     "max_redrops": [Interval(0, 100, integer=True)],
     "approach_speed_mps": [Interval(0, 10, "right", "m/s")],
     "close_s": [Interval(0, 60, "right", "s")],

@@ -238,17 +238,21 @@ class _Sim:
 
 
 def _settle(sim: _Sim) -> bool:
-    """Step until the object rests, falls below the support, or the time cap; True if it is on the support."""
+    """Step until the object rests (below both settle speeds for ``settle_hold_s``), falls below the
+    support, or the time cap; True if it is on the support."""
     cfg = sim.cfg.sim
     body = sim.ts.object_body
     min_steps = int(cfg.settle_min_s / sim.dt)
     below_z = sim.ts.table_z - cfg.fell_below_m
     linear_sq, angular_sq = cfg.settle_linear_mps**2, cfg.settle_angular_radps**2
+    hold_steps = max(1, round(cfg.settle_hold_s / sim.dt))
+    still = 0  # consecutive steps below both speeds
     for _ in range(int(cfg.settle_max_s / sim.dt)):
         sim.step()
         if body.get_entity_pose().p[2] < below_z:
             return False
-        if sim.steps >= min_steps and sim.speed_sq[0] < linear_sq and sim.speed_sq[1] < angular_sq:
+        still = still + 1 if sim.speed_sq[0] < linear_sq and sim.speed_sq[1] < angular_sq else 0
+        if sim.steps >= min_steps and still >= hold_steps:
             break
     return _on_support(sim.ts, sim.cfg)
 

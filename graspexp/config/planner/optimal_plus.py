@@ -5,7 +5,7 @@ shows the mechanism is named), not from the planner's score."""
 
 from dataclasses import dataclass, field
 
-from graspexp.config.constraints import Interval, Options, Vector
+from graspexp.config.constraints import Interval, Options, Vector, added
 from graspexp.config.planner.base import OPENING_CONSTRAINTS, OpeningConfig
 from graspexp.config.planner.optimal import PAPER_PATHS_CONSTRAINTS, PaperPathsConfig
 from graspexp.config.plugins import PlannerPlugin
@@ -57,7 +57,7 @@ class OptimalPlusConfig(PaperPathsConfig, OpeningConfig):
     """Share of each pad's contact points that must be grasping-area points (III-A: the robot grasps
     the area, not the part a person holds). The grasp point is aimed inside the area, but fingers 8 cm
     long can close on another part first (the iron's handle above its body)."""
-    fallback_contacts_in_area: float = 0.0
+    fallback_contacts_in_area: float = added(0.0, before=1.0)
     """In the modes of ``fallback_modes``, when no path passes with ``min_contacts_in_area``, the search
     is repeated requiring the largest share any try reached, if at least this (1.0: no fallback;
     ``extras["in_area_required"]`` records the share required). Some poses leave no grasp inside the
