@@ -110,6 +110,16 @@ ABLATIONS: tuple[Reading, ...] = (
         (*PLUS, "planner.min_contacts_in_area=0"),
         "optimal_plus, pads may touch outside the area",
     ),
+    Reading(
+        "plus_no_fallback",
+        (*PLUS, "planner.fallback_contacts_in_area=1.0"),
+        "optimal_plus, no area fallback (every contact in the area)",
+    ),
+    Reading(
+        "plus_fallback_collab",
+        (*PLUS, "planner.fallback_modes=[collab,bin]"),
+        "optimal_plus, the area fallback in collab mode too",
+    ),
     Reading("plus_n2048", (*PLUS, "planner.n_points=2048"), "optimal_plus with a 2048-point cloud"),
     Reading("plus_no_com", (*PLUS, "planner.com_weight=0"), "optimal_plus without the gravity-arm factor"),
     Reading(
