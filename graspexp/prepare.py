@@ -50,7 +50,7 @@ def prepare_shapes(
     if not missing:
         return
     dataset = OmegaConf.to_container(dataset_cfg, resolve=True)
-    workers = max(1, min(int(sim.prepare_workers), len(missing)))
+    workers = max(1, min(int(sim.prepare_workers), len(missing))) if _can_spawn() else 1
     desc = f"collision shapes ({sim.collision_method}, {dataset_cfg.name})"
     with tqdm(total=len(missing), desc=desc, disable=not progress) as bar:
         if workers == 1:
@@ -73,6 +73,14 @@ def prepare_shapes(
                     else:
                         _report(bar, fut.result())
                 bar.refresh()
+
+
+def _can_spawn() -> bool:
+    """False inside a worker of a joblib (loky) pool, e.g. a job of the benchmark or of
+    ``hydra/launcher=joblib``: its start method is ``loky``, which children spawned by plain
+    multiprocessing cannot re-create (they die with "cannot find context for 'loky'"). The pool already
+    uses the cores, so the shapes are built in this process."""
+    return multiprocessing.get_start_method(allow_none=True) in (None, "fork", "spawn", "forkserver")
 
 
 def _needs_build(dataset_cfg: DictConfig, sim: SimConfig | DictConfig, name: str) -> bool:

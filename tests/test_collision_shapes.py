@@ -117,6 +117,21 @@ def test_prepare_builds_every_missing_shape_in_parallel(tmp_path):
     assert all(is_cached(object_mesh(cfg.dataset, n)[0].mesh, cfg.sim) for n in names)
 
 
+def _prepare_and_check(cache_dir: str) -> bool:
+    cfg = compose_cfg("dataset=primitives", f"sim.cache_dir={cache_dir}", "sim.prepare_workers=2")
+    names = ["mug", "banana"]
+    prepare_shapes(cfg.dataset, cfg.sim, names, progress=False)
+    return all(is_cached(object_mesh(cfg.dataset, n)[0].mesh, cfg.sim) for n in names)
+
+
+@pytest.mark.slow
+def test_prepare_inside_a_joblib_worker_builds_in_process(tmp_path):
+    """A benchmark job runs in a loky worker, whose children cannot be spawned by multiprocessing."""
+    from joblib import Parallel, delayed
+
+    assert Parallel(n_jobs=2, backend="loky")([delayed(_prepare_and_check)(str(tmp_path))]) == [True]
+
+
 @pytest.mark.parametrize("name", ["025_mug", "005_tomato_soup_can"])
 def test_default_shape_is_within_1_mm_of_real_meshes(data_root, name):
     cfg = OmegaConf.create({"name": "ycb", "root": str(data_root), "objects": []})
