@@ -223,6 +223,8 @@ def _value_before(cfg: DictConfig, key: str) -> object:
             return f.metadata[BEFORE]
         if f.name == leaf and f.default is not dataclasses.MISSING:
             return f.default
+        if f.name == leaf and f.default_factory is not dataclasses.MISSING:
+            return f.default_factory()
     return _NO_DEFAULT
 
 

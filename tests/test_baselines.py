@@ -234,3 +234,18 @@ def test_antipodal_area_keeps_both_contacts_in_the_area() -> None:
     assert mask[inside].all() and len(inside) > 0
     g = plan(_request("antipodal_area", pts, normals, area=mask)).grasp
     assert g.planner == "antipodal_area"
+
+
+def test_antipodal_area_pads_keeps_the_pads_in_the_area() -> None:
+    """A band narrower than a pad: the sampled contacts lie in it, the pads cannot."""
+    box = trimesh.creation.box((0.09, 0.06, 0.04))
+    pts, normals = _cloud(box, n=3000)
+    band = np.abs(pts[:, 0]) < 0.004
+    loose = plan(_request("antipodal_area", pts, normals, area=band)).grasp
+    assert "in_area_required" not in loose.extras  # contacts sampled in the band, pads not checked
+    with pytest.raises(NoFeasibleGrasp, match=r"in the grasping area .*this is collab"):
+        plan(_request("antipodal_area_pads", pts, normals, mode="collab", area=band))
+    g = plan(_request("antipodal_area_pads", pts, normals, mode="bin", area=band)).grasp
+    assert 0.0 < g.extras["in_area_required"] < 1.0  # bin picking: the candidate touching the band most
+    whole = plan(_request("antipodal_area_pads", pts, normals, mode="collab")).grasp
+    assert whole.extras["in_area_required"] == 1.0

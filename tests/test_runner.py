@@ -104,6 +104,17 @@ def test_a_key_added_with_a_new_behaviour_counts_as_its_value_before() -> None:
     assert config_differences(old_log, compose_cfg(*BASE, "sim.settle_hold_s=0")) == {}
 
 
+def test_a_list_key_added_since_the_log_counts_as_equal_at_its_default() -> None:
+    cfg = compose_cfg(*BASE, "planner=antipodal")
+    recorded = OmegaConf.create(job_metadata(cfg)["config_yaml"])
+    del recorded.planner["fallback_modes"]  # a list default (default_factory)
+    assert config_differences(OmegaConf.to_yaml(recorded), cfg) == {}
+    changed = compose_cfg(*BASE, "planner=antipodal", "planner.fallback_modes=[collab]")
+    assert config_differences(OmegaConf.to_yaml(recorded), changed) == {
+        "planner.fallback_modes": ("<absent>", ["collab"])
+    }
+
+
 @pytest.mark.parametrize(
     ("overrides", "message"),
     [

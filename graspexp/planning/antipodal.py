@@ -18,18 +18,26 @@ Steps (cloud and normals in the world frame, metres; normals point outwards):
 5. cost = ``max(a1, a2)`` (degrees) + ``planner.approach_tilt_weight`` * the angle between the approach
    and world -Z (degrees); the cheapest surviving candidate wins. Pairs are examined in ascending
    ``max(a1, a2)``, which is a lower bound on their cost, so examination stops once it exceeds the best.
+6. with ``planner.min_contacts_in_area`` > 0 (preset ``antipodal_area_pads``), a candidate survives step
+   4 only if both pads' contacts are grasping-area points, with the fallback of
+   :mod:`graspexp.planning.area_rule` (the rule ``optimal_plus`` follows): the two contacts of step 2
+   lie in the area, but the pads close on whatever lies between them first.
 
-``Grasp.n_feasible`` counts the surviving candidates among the examined pairs.
+``Grasp.n_feasible`` counts the surviving candidates among the examined pairs; ``extras`` holds
+``in_area_required`` when step 6 applies.
 ``details``: ``pairs`` (P, 2) cloud indices, ``pair_angles_deg`` (P,), ``examined`` (number of pairs
 examined), ``best_pair`` (2,).
 """
 
 import numpy as np
 
+from graspexp.config.gripper import GripperGeometry
+from graspexp.planning.area_rule import fallback_share, no_grasp_in_area
 from graspexp.planning.collision import frame_from_axes, place_for_request
 from graspexp.planning.friction import cone_cosine, line_cone_cosines
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.request import PlanRequest, PlanResult
+from graspexp.planning.stability import pad_contacts
 
 NAME = "antipodal"
 
@@ -134,9 +142,71 @@ def plan_antipodal(req: PlanRequest) -> PlanResult:
             f"(mu = {pl.friction_coef}) within the stroke {gr.max_width_m} m"
         )
 
+    need = pl.min_contacts_in_area
+    best, rejected, examined, n_ok, best_share = _search(req, points, normals, pairs, angles, need)
+    if best is None and need > 0 and (share := fallback_share(req, best_share)) is not None:
+        need = share
+        best, _, examined, n_ok, _ = _search(req, points, normals, pairs, angles, need)
+    if best is None:
+        raise NoFeasibleGrasp(
+            f"antipodal: all {examined * int(pl.n_approach)} candidates of {len(pairs)} antipodal pairs "
+            f"failed: {rejected['n_too_wide']} too wide for the stroke, {rejected['n_below_support']} below "
+            f"the support, {rejected['n_collides']} colliding with the cloud"
+            + (
+                f", {rejected['n_outside_area']} with " + no_grasp_in_area(req, best_share)
+                if need > 0
+                else ""
+            )
+        )
+    cost, i, pose, width = best
+    grasp = Grasp(
+        pose=pose,
+        width_m=width,
+        cost=cost,
+        cluster=-1,
+        path=int(i),
+        n_feasible=n_ok,
+        planner=req.planner.name,
+        extras={
+            "n_pairs": int(len(pairs)),
+            "n_examined": int(examined),
+            "pair_angle_deg": float(angles[i]),
+            **rejected,
+            **({"in_area_required": float(need)} if pl.min_contacts_in_area > 0 else {}),
+        },
+    )
+    details = {
+        "cloud": points,
+        "pairs": pairs,
+        "pair_angles_deg": angles,
+        "examined": np.int64(examined),
+        "best_pair": pairs[i],
+        "pose": pose,
+        "width": np.float64(width),
+    }
+    return PlanResult(grasp=grasp, details=details)
+
+
+def _search(
+    req: PlanRequest,
+    points: np.ndarray,
+    normals: np.ndarray,
+    pairs: np.ndarray,
+    angles: np.ndarray,
+    need: float,
+) -> tuple[tuple[float, int, np.ndarray, float] | None, dict[str, int], int, int, float]:
+    """Steps 3-6 of the module doc over the (P, 2) ``pairs`` in ascending ``angles``, requiring ``need``
+    of each pad's contact in the area (0: not checked): the best (cost, pair, pose, width) or None, the
+    rejection counts, the pairs examined, the surviving candidates and the largest in-area share of the
+    candidates that passed steps 3-4 (0 if none)."""
+    pl = req.planner
     best: tuple[float, int, np.ndarray, float] | None = None  # cost, pair index, pose, width
     rejected = {"n_too_wide": 0, "n_below_support": 0, "n_collides": 0}
+    if need > 0:
+        rejected["n_outside_area"] = 0
+        geometry = GripperGeometry.of(req.gripper)
     examined = n_ok = 0
+    best_share = 0.0
     for s in range(0, len(pairs), PAIR_BATCH):
         if best is not None and angles[s] >= best[0]:
             break
@@ -154,40 +224,18 @@ def plan_antipodal(req: PlanRequest) -> PlanResult:
         placed = place_for_request(req, np.array(poses))
         for key, n in placed.counts().items():
             rejected[key] += n
-        n_ok += int(placed.ok.sum())
-        cost = np.where(placed.ok, np.concatenate(costs), np.inf)
+        ok = placed.ok
+        if need > 0 and ok.any():
+            share = np.zeros(len(ok))
+            share[ok] = pad_contacts(
+                points, normals, placed.poses[ok], geometry, pl.contact_band_m, req.area_mask
+            )[2]
+            best_share = max(best_share, float(share[ok].max()))
+            rejected["n_outside_area"] += int((ok & (share < need)).sum())
+            ok = ok & (share >= need)
+        n_ok += int(ok.sum())
+        cost = np.where(ok, np.concatenate(costs), np.inf)
         j = int(np.argmin(cost))
         if np.isfinite(cost[j]) and (best is None or cost[j] < best[0]):
             best = (float(cost[j]), owners[j], placed.poses[j], float(placed.widths_m[j]))
-    if best is None:
-        raise NoFeasibleGrasp(
-            f"antipodal: all {examined * int(pl.n_approach)} candidates of {len(pairs)} antipodal pairs "
-            f"failed: {rejected['n_too_wide']} too wide for the stroke, {rejected['n_below_support']} below "
-            f"the support, {rejected['n_collides']} colliding with the cloud"
-        )
-    cost, i, pose, width = best
-    grasp = Grasp(
-        pose=pose,
-        width_m=width,
-        cost=cost,
-        cluster=-1,
-        path=int(i),
-        n_feasible=n_ok,
-        planner=req.planner.name,
-        extras={
-            "n_pairs": int(len(pairs)),
-            "n_examined": int(examined),
-            "pair_angle_deg": float(angles[i]),
-            **rejected,
-        },
-    )
-    details = {
-        "cloud": points,
-        "pairs": pairs,
-        "pair_angles_deg": angles,
-        "examined": np.int64(examined),
-        "best_pair": pairs[i],
-        "pose": pose,
-        "width": np.float64(width),
-    }
-    return PlanResult(grasp=grasp, details=details)
+    return best, rejected, examined, n_ok, best_share

@@ -47,6 +47,7 @@ import numpy as np
 
 from graspexp.config.gripper import GripperGeometry
 from graspexp.geometry import transform_points
+from graspexp.planning.area_rule import fallback_share, no_grasp_in_area
 from graspexp.planning.collision import cloud_hits, place_for_request
 from graspexp.planning.friction import cone_cosine
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
@@ -100,21 +101,17 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
         req, cand, geometry, floors, pl.min_contacts_in_area
     )
     in_area_required = pl.min_contacts_in_area
-    fallback = req.mode in pl.fallback_modes and pl.fallback_contacts_in_area <= best_share
-    if not passed and fallback and best_share < pl.min_contacts_in_area:
-        # step 6 of the module doc: the tries touching the area most
-        in_area_required = best_share
-        passed = _search_paths(req, cand, geometry, floors, best_share)[0]
+    if not passed and (share := fallback_share(req, best_share)) is not None:  # step 6 of the module doc
+        in_area_required = share
+        passed = _search_paths(req, cand, geometry, floors, share)[0]
     if not passed:
         raise NoFeasibleGrasp(
             f"optimal_plus: all {examined} paths above the support failed at every depth: "
             f"{rejected['n_too_wide']} tries too wide for the stroke {gr.max_width_m} m, "
             f"{rejected['n_below_support']} below the support, {rejected['n_collides']} colliding with the "
             f"cloud, {rejected['n_weak_contact']} with a pad contact shallower than {pl.min_pad_depth_m} m "
-            f"or outside the friction cone, {rejected['n_outside_area']} with less than "
-            f"{pl.min_contacts_in_area} of a pad's contact in the grasping area (the best passing try: "
-            f"{best_share:.2f}; fallback_contacts_in_area {pl.fallback_contacts_in_area} in the modes "
-            f"{list(pl.fallback_modes)}, this is {req.mode})"
+            f"or outside the friction cone, {rejected['n_outside_area']} with "
+            + no_grasp_in_area(req, best_share)
         )
     passed = passed[: pl.shortlist]
     poses = np.stack([p[2] for p in passed])

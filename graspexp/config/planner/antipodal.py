@@ -3,12 +3,12 @@
 from dataclasses import dataclass
 
 from graspexp.config.constraints import BOOL, Interval
-from graspexp.config.planner.base import OPENING_CONSTRAINTS, OpeningConfig
+from graspexp.config.planner.base import AREA_CONTACT_CONSTRAINTS, AreaContactConfig
 from graspexp.config.plugins import PlannerPlugin
 
 
 @dataclass
-class AntipodalConfig(OpeningConfig):
+class AntipodalConfig(AreaContactConfig):
     n_candidates: int = 256
     """First-contact points sampled."""
     n_approach: int = 12
@@ -16,15 +16,19 @@ class AntipodalConfig(OpeningConfig):
     friction_coef: float = 0.5
     """Friction coefficient mu of the sampling cone, half-angle atan(mu) (dimensionless)."""
     sample_area_only: bool = False
-    """Both contacts from the grasping area (preset ``antipodal_area``: the fair comparison for planners that
-    must grasp the area); False: from the whole cloud, as GPD."""
+    """Both contacts from the grasping area (preset ``antipodal_area``); False: from the whole cloud, as
+    GPD. The pads may still close on another part first; preset ``antipodal_area_pads`` adds
+    ``min_contacts_in_area`` 1.0, the area rule ``optimal_plus`` follows."""
+    fallback_contacts_in_area: float = 0.0
+    """As :class:`AreaContactConfig`. Declared here without a value before it: runs made before the key
+    existed checked no pad contacts (``min_contacts_in_area`` 0), where the fallback changes nothing."""
     approach_tilt_weight: float = 0.1
     """Cost per degree between the approach and straight down, added to the contacts' worst
     friction-cone angle (degrees), so top-down approaches win among equally antipodal pairs."""
 
 
 CONSTRAINTS = {
-    **OPENING_CONSTRAINTS,
+    **AREA_CONTACT_CONSTRAINTS,
     "n_candidates": [Interval(1, 1_000_000, integer=True)],
     "n_approach": [Interval(1, 3600, integer=True)],
     "friction_coef": [Interval(0, 10)],
@@ -36,4 +40,4 @@ CONSTRAINTS = {
 PLUGIN = PlannerPlugin(
     plan="graspexp.planning.antipodal:plan_antipodal", config=AntipodalConfig, constraints=CONSTRAINTS
 )
-"""Entry point of ``antipodal`` and of ``antipodal_area`` (the same function, another preset)."""
+"""Entry point of ``antipodal``, ``antipodal_area`` and ``antipodal_area_pads`` (one function, three presets)."""

@@ -5,11 +5,11 @@ classes here); its constraints mapping (``CONSTRAINTS`` beside it) covers every 
 included, so that ``{**BASE_CONSTRAINTS, ...}`` is the usual way to write it.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from omegaconf import MISSING
 
-from graspexp.config.constraints import TEXT, Interval
+from graspexp.config.constraints import TEXT, Interval, Options, Vector, added
 
 
 @dataclass
@@ -55,3 +55,39 @@ class OpeningConfig(CollisionConfig):
 
 
 OPENING_CONSTRAINTS = {**COLLISION_CONSTRAINTS, "width_clearance_m": [Interval(0, 0.1, unit="m")]}
+
+
+@dataclass
+class AreaContactConfig(OpeningConfig):
+    """Planners that check where their pads touch: each pad's contact points (the cloud points within
+    ``contact_band_m`` of the section's extreme between the pads) must be grasping-area points
+    (:func:`graspexp.planning.stability.pad_contacts`, :mod:`graspexp.planning.area_rule`)."""
+
+    min_contacts_in_area: float = 0.0
+    """Share of each pad's contact points that must be grasping-area points (III-A: the robot grasps the
+    area, not the part a person holds); 0: not checked. Fingers 8 cm long can close on another part
+    first (the iron's handle above its body), so aiming at area points is not enough."""
+    fallback_contacts_in_area: float = added(0.0, before=1.0)
+    """In the modes of ``fallback_modes``, when no grasp passes with ``min_contacts_in_area``, the search
+    is repeated requiring the largest share any otherwise passing try reached, if at least this (1.0:
+    no fallback; the grasp's ``extras["in_area_required"]`` records the share required). Some poses
+    leave no grasp inside the area: the cat on its side closes on its legs or head whatever the path
+    (the best try's share is 0-0.14), the iron on its side on the soleplate or the handle. 0: the grasp
+    touching the area most, rather than none; the in-area metric reports every such trial."""
+    fallback_modes: list[str] = field(default_factory=lambda: ["bin"])
+    """Modes in which the fallback applies. ``bin``: nobody holds the object, the area is the task's
+    preference (III-A), and a pick outside it beats no pick. Not ``collab``: there a person holds the
+    rest of the object (IV-C, hand-over), so a grasp outside the area would take their hand; none is
+    planned."""
+    contact_band_m: float = 0.004
+    """Points within this of a side's extreme y count as that pad's contacts, m: about the cloud's point
+    spacing (2048 points on a Table 1 object)."""
+
+
+AREA_CONTACT_CONSTRAINTS = {
+    **OPENING_CONSTRAINTS,
+    "min_contacts_in_area": [Interval(0, 1)],
+    "fallback_contacts_in_area": [Interval(0, 1)],
+    "fallback_modes": [Vector(None, Options(("collab", "bin")))],
+    "contact_band_m": [Interval(0, 0.05, "right", "m")],
+}

@@ -5,14 +5,14 @@ shows the mechanism is named), not from the planner's score."""
 
 from dataclasses import dataclass, field
 
-from graspexp.config.constraints import Interval, Options, Vector, added
-from graspexp.config.planner.base import OPENING_CONSTRAINTS, OpeningConfig
+from graspexp.config.constraints import Interval, Options, Vector
+from graspexp.config.planner.base import AREA_CONTACT_CONSTRAINTS, AreaContactConfig
 from graspexp.config.planner.optimal import PAPER_PATHS_CONSTRAINTS, PaperPathsConfig
 from graspexp.config.plugins import PlannerPlugin
 
 
 @dataclass
-class OptimalPlusConfig(PaperPathsConfig, OpeningConfig):
+class OptimalPlusConfig(PaperPathsConfig, AreaContactConfig):
     n_points: int = 4096
     """Size N of the object's surface cloud. 4096, not 2048: the pad-contact test (``contact_band_m``)
     needs points about a band apart, and 2048 points on the iron (the largest Table 2 object) are 7 mm
@@ -54,24 +54,7 @@ class OptimalPlusConfig(PaperPathsConfig, OpeningConfig):
     ``sim.object_dynamic_friction`` 0.5. (The first value, 0.5, the antipodal baseline's, was stricter
     than the simulation: the cone test cost 8 points on LINEMOD in the ablations with it.)"""
     min_contacts_in_area: float = 1.0
-    """Share of each pad's contact points that must be grasping-area points (III-A: the robot grasps
-    the area, not the part a person holds). The grasp point is aimed inside the area, but fingers 8 cm
-    long can close on another part first (the iron's handle above its body)."""
-    fallback_contacts_in_area: float = added(0.0, before=1.0)
-    """In the modes of ``fallback_modes``, when no path passes with ``min_contacts_in_area``, the search
-    is repeated requiring the largest share any try reached, if at least this (1.0: no fallback;
-    ``extras["in_area_required"]`` records the share required). Some poses leave no grasp inside the
-    area: the cat on its side closes on its legs or head whatever the path (the best try's share is
-    0-0.14), the iron on its side on the soleplate or the handle. 0: the grasp touching the area most,
-    rather than none; the in-area metric reports every such trial."""
-    fallback_modes: list[str] = field(default_factory=lambda: ["bin"])
-    """Modes in which the fallback applies. ``bin``: nobody holds the object, the area is the task's
-    preference (III-A), and a pick outside it beats no pick. Not ``collab``: there a person holds the
-    rest of the object (IV-C, hand-over), so a grasp outside the area would take their hand; none is
-    planned."""
-    contact_band_m: float = 0.004
-    """Points within this of a side's extreme y count as that pad's contacts, m: about the cloud's point
-    spacing (2048 points on a Table 1 object)."""
+    """Every pad contact point in the grasping area (see :class:`AreaContactConfig`)."""
     com_weight: float = 1.0
     """Cost factor ``1 + com_weight * arm / D`` (arm of gravity about the closing axis, D the object's
     box diagonal, m/m); 0 switches it off. 1: a grasp at the far end of the object costs up to twice a
@@ -92,7 +75,7 @@ class OptimalPlusConfig(PaperPathsConfig, OpeningConfig):
 
 CONSTRAINTS = {
     **PAPER_PATHS_CONSTRAINTS,
-    **OPENING_CONSTRAINTS,
+    **AREA_CONTACT_CONSTRAINTS,
     "opening": [Options(("section", "cluster"))],
     "cluster_length": [Options(("finger_width", "stroke"))],
     "rolls_deg": [Vector(None, Interval(-180, 180, unit="deg"))],
@@ -100,10 +83,6 @@ CONSTRAINTS = {
     "min_pad_depth_m": [Interval(-0.5, 0.5, unit="m")],
     "pad_depth_target_m": [Interval(0, 0.5, unit="m")],
     "friction_coef": [Interval(0, 10, "right")],
-    "min_contacts_in_area": [Interval(0, 1)],
-    "fallback_contacts_in_area": [Interval(0, 1)],
-    "fallback_modes": [Vector(None, Options(("collab", "bin")))],
-    "contact_band_m": [Interval(0, 0.05, "right", "m")],
     "com_weight": [Interval(0, 100)],
     "shortlist": [Interval(1, 100_000, integer=True)],
     "noise_trans_mm": [Interval(0, 100, unit="mm")],
