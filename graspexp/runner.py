@@ -219,11 +219,13 @@ def _value_before(cfg: DictConfig, key: str) -> object:
     node = OmegaConf.select(cfg, parent) if parent else cfg
     schema = OmegaConf.get_type(node) if isinstance(node, DictConfig) else None
     for f in dataclasses.fields(schema) if dataclasses.is_dataclass(schema) else ():
-        if f.name == leaf and BEFORE in f.metadata:
+        if f.name != leaf:
+            continue
+        if BEFORE in f.metadata:
             return f.metadata[BEFORE]
-        if f.name == leaf and f.default is not dataclasses.MISSING:
+        if f.default is not dataclasses.MISSING:
             return f.default
-        if f.name == leaf and f.default_factory is not dataclasses.MISSING:
+        if f.default_factory is not dataclasses.MISSING:
             return f.default_factory()
     return _NO_DEFAULT
 

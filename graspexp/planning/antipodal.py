@@ -32,7 +32,7 @@ examined), ``best_pair`` (2,).
 import numpy as np
 
 from graspexp.config.gripper import GripperGeometry
-from graspexp.planning.area_rule import fallback_share, no_grasp_in_area
+from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
 from graspexp.planning.collision import frame_from_axes, place_for_request
 from graspexp.planning.friction import cone_cosine, line_cone_cosines
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
@@ -225,14 +225,15 @@ def _search(
         for key, n in placed.counts().items():
             rejected[key] += n
         ok = placed.ok
-        if need > 0 and ok.any():
+        if need > 0:
             share = np.zeros(len(ok))
-            share[ok] = pad_contacts(
-                points, normals, placed.poses[ok], geometry, pl.contact_band_m, req.area_mask
-            )[2]
-            best_share = max(best_share, float(share[ok].max()))
-            rejected["n_outside_area"] += int((ok & (share < need)).sum())
-            ok = ok & (share >= need)
+            if ok.any():
+                share[ok] = pad_contacts(
+                    points, normals, placed.poses[ok], geometry, pl.contact_band_m, req.area_mask
+                )[2]
+            ok, n_outside, batch_best = area_test(ok, share, need)
+            rejected["n_outside_area"] += n_outside
+            best_share = max(best_share, batch_best)
         n_ok += int(ok.sum())
         cost = np.where(ok, np.concatenate(costs), np.inf)
         j = int(np.argmin(cost))

@@ -7,7 +7,17 @@ A try passes when the smaller of its two pads' shares of contact points in the g
 otherwise passing try reached, if that is at least ``fallback_contacts_in_area``.
 """
 
+import numpy as np
+
 from graspexp.planning.request import PlanRequest
+
+
+def area_test(held: np.ndarray, share: np.ndarray, need: float) -> tuple[np.ndarray, int, float]:
+    """For (B,) tries ``held`` (passing every other check) and their (B,) in-area ``share``: (B,) the
+    tries with at least ``need`` of each pad's contact in the area, how many of ``held`` fail only this,
+    and the largest share among ``held`` (0 if none)."""
+    ok = held & (share >= need)
+    return ok, int((held & ~ok).sum()), float(share[held].max()) if held.any() else 0.0
 
 
 def fallback_share(req: PlanRequest, best_share: float) -> float | None:

@@ -38,8 +38,8 @@ is tried at several depths along its approach, and every try is checked as follo
 Examination stops once ``shortlist`` paths pass 1-3. ``Grasp.n_feasible`` counts them; ``extras`` holds
 ``K``, ``M``, ``n_examined``, the rejections (``n_too_wide``, ``n_below_support``, ``n_collides``,
 ``n_weak_contact``, ``n_outside_area``), ``in_area_required``, ``pad_depth_m``, ``gravity_arm_m``,
-``depth_offset_m``, ``noise_pass`` and ``com_factor``. ``details`` holds the same keys as ``optimal`` where they apply (``cloud``,
-``area_mask``, ``labels``, ``centers``, ``radii``, ``main_axis``, ``directions``, ``costs`` (K, M; the
+``depth_offset_m``, ``noise_pass`` and ``com_factor``. ``details`` holds the same keys as ``optimal``
+where they apply (``cloud``, ``area_mask``, ``labels``, ``centers``, ``radii``, ``main_axis``, ``directions``, ``costs`` (K, M; the
 paper's, inf where removed by the plane test), ``best``, ``pose``, ``width``) plus ``com`` (3,).
 """
 
@@ -47,7 +47,7 @@ import numpy as np
 
 from graspexp.config.gripper import GripperGeometry
 from graspexp.geometry import transform_points
-from graspexp.planning.area_rule import fallback_share, no_grasp_in_area
+from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
 from graspexp.planning.collision import cloud_hits, place_for_request
 from graspexp.planning.friction import cone_cosine
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
@@ -203,13 +203,12 @@ def _search_paths(
                 pl, geometry, points, normals, cand.area_mask, placed.poses[placed.ok]
             )
         held &= placed.ok
-        ok = held & (share >= min_share)
+        ok, n_outside, batch_best = area_test(held, share, min_share)
         for key, n in placed.counts().items():
             rejected[key] += n
         rejected["n_weak_contact"] += int((placed.ok & ~held).sum())
-        rejected["n_outside_area"] += int((held & ~ok).sum())
-        if held.any():
-            best_share = max(best_share, float(share[held].max()))
+        rejected["n_outside_area"] += n_outside
+        best_share = max(best_share, batch_best)
         ok, depth = ok.reshape(b, n_roll, n_off), depth.reshape(b, n_roll, n_off)
         # per path: the first roll with a passing try, then the target depth with the smallest move
         for i in np.flatnonzero(ok.any(axis=(1, 2))):
