@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from graspexp.datasets import job_object
-from graspexp.geometry import make_pose
+from graspexp.geometry import make_pose, quat_wxyz_to_matrix
 from graspexp.outcome import FailureReason
 from graspexp.planning import plan
 from graspexp.planning.grasp import Grasp
@@ -162,3 +162,35 @@ def test_a_rocking_object_is_settled_only_after_settle_hold_s(hold_s, rests, dat
     assert res.reason == FailureReason.NO_CONTACT.value
     moved_m = np.linalg.norm(track.positions[-1] - seen["pose"][:3, 3])
     assert (moved_m < 0.001) == rests, moved_m
+
+
+class PalmAtClose(NullRecorder):
+    """Keeps the planned grasp pose and the palm's pose when the fingers start closing."""
+
+    active = True
+
+    def __init__(self):
+        self.pose = self.palm = self.at_close = None
+
+    def grasp(self, t_s, grasp):
+        self.pose = np.asarray(grasp["pose"], dtype=float)
+
+    def transforms(self, t_s, frames):
+        if "palm" in frames:
+            self.palm = frames["palm"]
+
+    def phase(self, t_s, name, info=None):
+        if name == "close":
+            self.at_close = self.palm
+
+
+@pytest.mark.parametrize(("settle_s", "reached"), [(0.0, False), (0.2, True)])
+def test_the_fingers_close_only_once_the_arm_has_reached_the_grasp_pose(settle_s, reached):
+    """The arm's drive lags the moving approach target by damping x speed / stiffness (5 mm for the RG2 at
+    0.25 m/s): without ``sim.approach_settle_s`` the fingers start closing with the gripper that far short."""
+    rec = PalmAtClose()
+    run_trial(_ctx("mode=collab", "sim.log_rate_hz=240", f"sim.approach_settle_s={settle_s}", recorder=rec))
+    p, q = rec.at_close
+    palm = make_pose(quat_wxyz_to_matrix(np.asarray(q)), np.asarray(p))
+    short_m = float(np.linalg.norm((np.linalg.inv(rec.pose) @ palm)[:3, 3]))
+    assert (short_m < 5e-4) if reached else (short_m > 3e-3), short_m

@@ -35,6 +35,14 @@ class SimConfig:
     """Re-drops allowed when the object falls off the support."""
     approach_speed_mps: float = 0.25
     """Speed of the move from pre-grasp to grasp, m/s."""
+    approach_settle_s: float = added(0.2, before=0.0)
+    """Time the arm holds the grasp pose after the approach before the fingers close, s. The arm's drive
+    lags its moving target by damping x speed / stiffness (``gripper.arm_damping_ns_per_m`` x
+    ``approach_speed_mps`` / ``gripper.arm_stiffness_n_per_m`` = 5 mm for the RG2), so with 0 the fingers
+    started closing with the gripper still 4-5 mm short of the grasp pose and moving, met the object a few
+    mm short of the planned pad depth and pushed it 1-2 mm along the approach as the arm caught up (logs
+    of optimal_plus's mug and power-drill failures). A robot's controller reaches its goal before the
+    gripper is commanded; 0.2 s is 10 time constants of the drive (damping / stiffness = 0.02 s)."""
     close_s: float = 0.6
     """Time given to the fingers to close, s."""
     retract_speed_mps: float = 0.25
@@ -120,6 +128,7 @@ CONSTRAINTS = {
     "settle_hold_s": [Interval(0, 10, unit="s")],
     "max_redrops": [Interval(0, 100, integer=True)],
     "approach_speed_mps": [Interval(0, 10, "right", "m/s")],
+    "approach_settle_s": [Interval(0, 60, unit="s")],
     "close_s": [Interval(0, 60, "right", "s")],
     "retract_speed_mps": [Interval(0, 10, "right", "m/s")],
     "slip_threshold_m": [None, Interval(0, 1, "right", "m")],

@@ -59,6 +59,7 @@ PHASE_NAMES = (
     "plan",
     "pre_grasp",
     "approach",
+    "settle_arm",
     "close",
     "remove_support",
     "pull_back",

@@ -407,6 +407,9 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
         standoff / scfg.approach_speed_mps,
         lambda s: gripper.drive_arm(np.array([0.0, 0.0, -standoff * (1 - s)])),
     )
+    if scfg.approach_settle_s > 0:
+        sim.phase("settle_arm", {"duration_s": scfg.approach_settle_s})
+        sim.run(scfg.approach_settle_s)  # the arm reaches the grasp pose before the fingers close
     sim.phase("close")
     gripper.close()
     sim.run(scfg.close_s)
