@@ -9,8 +9,15 @@ import trimesh
 from test_baselines import TABLE_Z, _cfg, _cloud
 
 from graspexp.config.gripper import GripperGeometry
+from graspexp.geometry import make_pose, random_rotation
 from graspexp.planning import NoFeasibleGrasp, PlanRequest, plan
-from graspexp.planning.stability import gravity_arm_m, pad_contacts, pose_perturbations, volume_centroid_m
+from graspexp.planning.stability import (
+    gravity_arm_m,
+    pad_contacts,
+    pad_edge_excess_m,
+    pose_perturbations,
+    volume_centroid_m,
+)
 
 
 def _request(pts, normals, area=None, seed: int = 3, mode: str = "bin", **planner) -> PlanRequest:
@@ -125,17 +132,20 @@ def test_depth_offsets_move_the_grasp_towards_the_target_depth() -> None:
     box = trimesh.creation.box((0.05, 0.05, 0.1))
     pts, normals = _cloud(box, n=2000)
     depth = {
-        t: plan(_request(pts, normals, pad_depth_target_m=t)).grasp.extras["pad_depth_m"]
+        t: plan(_request(pts, normals, pad_depth_target_m=t, choose_by="cost")).grasp.extras["pad_depth_m"]
         for t in (0.012, 0.045)
     }
     assert depth[0.045] > 0.035  # the table stops the fingertips short of the target
     assert depth[0.012] < depth[0.045] - 0.005  # reached without moving: the smallest move wins
-    only = plan(_request(pts, normals, depth_offsets_m=[0.0], pad_depth_target_m=0.045)).grasp
+    only = plan(
+        _request(pts, normals, depth_offsets_m=[0.0], pad_depth_target_m=0.045, choose_by="cost")
+    ).grasp
     assert only.extras["depth_offset_m"] == 0.0
 
 
 def test_com_weight_prefers_grasps_near_the_centre_of_mass() -> None:
-    """A hammer-like bar: a heavy head at one end, the area the whole handle."""
+    """A hammer-like bar: a heavy head at one end, the area the whole handle (the factor scales the
+    paper's cost: ``choose_by=cost``; with ``edge_clearance`` it breaks ties)."""
     handle = trimesh.creation.box((0.24, 0.03, 0.03))
     head = trimesh.creation.box((0.04, 0.09, 0.06))
     head.apply_translation([0.14, 0.0, 0.015])  # x from 0.12, where the handle ends
@@ -143,9 +153,55 @@ def test_com_weight_prefers_grasps_near_the_centre_of_mass() -> None:
     pts, normals = _cloud(hammer, n=3000)
     area = pts[:, 0] < 0.11
     arms = {
-        w: plan(_request(pts, normals, area, com_weight=w)).grasp.extras["gravity_arm_m"] for w in (0.0, 20.0)
+        w: plan(_request(pts, normals, area, com_weight=w, choose_by="cost")).grasp.extras["gravity_arm_m"]
+        for w in (0.0, 20.0)
     }
     assert arms[20.0] < arms[0.0] - 0.01
+
+
+def _slab(lo, hi) -> trimesh.Trimesh:
+    """An axis-aligned box from corner ``lo`` to corner ``hi`` (3,), m."""
+    box = trimesh.creation.box(np.subtract(hi, lo))
+    box.apply_translation(np.add(lo, hi) / 2)
+    return box
+
+
+def test_pad_edge_excess_is_how_far_the_object_reaches_past_a_pad_beside_the_finger() -> None:
+    geo = _geometry()
+    frame = np.eye(4)[None]
+    half = geo.finger_width_m / 2
+    body = _slab((-0.05, -0.02, -0.06), (0.05, 0.02, 0.0))  # faces at y = +-0.02 across the pads
+    pts = trimesh.sample.sample_surface_even(body, 8000, seed=1)[0]
+
+    def excess(*parts) -> float:
+        extra = [trimesh.sample.sample_surface_even(p, 2000, seed=2)[0] for p in parts]
+        return float(pad_edge_excess_m(np.vstack([pts, *extra]), frame, geo, 0.002)[0])
+
+    assert excess() == pytest.approx(0.0, abs=1e-9)  # a flat face running on past the pad
+    beside = _slab((half + 0.0005, 0.02, -0.06), (half + 0.0035, 0.023, 0.0))  # a 3 mm rib beside the pad
+    assert excess(beside) == pytest.approx(0.003, abs=1e-6)
+    away = _slab((half + 0.005, 0.02, -0.06), (half + 0.008, 0.023, 0.0))  # 5 mm away: outside the band
+    assert excess(away) == pytest.approx(0.0, abs=1e-9)
+    ledge = _slab((-0.05, 0.02, geo.tip_z_m + 0.0005), (0.05, 0.024, geo.tip_z_m + 0.0015))  # past the tips
+    assert excess(ledge) == pytest.approx(0.004, abs=1e-6)
+    assert pad_edge_excess_m(pts + [1.0, 0.0, 0.0], frame, geo, 0.002)[0] == -np.inf  # nothing in reach
+
+
+def test_choose_by_edge_clearance_takes_the_grasp_whose_pads_not_edges_meet_the_object() -> None:
+    """A cone in random poses: among the same shortlist, ``cost`` takes grasps with the cone's surface
+    rising past a pad beside its finger; ``edge_clearance`` takes one clear of it where one exists."""
+    cone = trimesh.creation.cone(radius=0.04, height=0.1, sections=48)
+    rng = np.random.default_rng(0)
+    by_cost, by_edges = [], []
+    for _ in range(5):
+        turned = cone.copy()
+        turned.apply_transform(make_pose(random_rotation(rng), np.zeros(3)))
+        pts, normals = _cloud(turned, n=3000)
+        by_cost.append(plan(_request(pts, normals, choose_by="cost")).grasp.extras["edge_excess_m"])
+        by_edges.append(plan(_request(pts, normals)).grasp.extras["edge_excess_m"])
+    assert all(e <= max(c, 0.0) + 1e-12 for c, e in zip(by_cost, by_edges, strict=True))
+    assert sum(c > 0.0005 for c in by_cost) >= 3  # the cheapest path often has a pad edge on the cone
+    assert sum(e <= 0.0 for e in by_edges) >= 4
 
 
 def test_opening_cluster_is_at_least_the_papers_opening() -> None:

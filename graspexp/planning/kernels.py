@@ -286,6 +286,35 @@ def slab_spans(
 
 
 @_jit
+def _pad_reach(
+    r: np.ndarray,
+    points: np.ndarray,
+    half_width: float,
+    z_lo: float,
+    z_hi: float,
+    xs: np.ndarray,
+    ys: np.ndarray,
+    zs: np.ndarray,
+    inside: np.ndarray,
+) -> tuple[float, float]:
+    """The (N, 3) world ``points`` in the frame of the (4, 4) world pose ``r``, written into ``xs`` (|x|),
+    ``ys``, ``zs`` and ``inside`` (in the pads' reach: ``|x| <= half_width``, ``z_lo <= z <= z_hi``); returns
+    the reach's extreme (lo, hi) along y, (inf, -inf) where no point is in it."""
+    lo, hi = np.inf, -np.inf
+    for i in range(points.shape[0]):
+        px, py, pz = points[i, 0] - r[0, 3], points[i, 1] - r[1, 3], points[i, 2] - r[2, 3]
+        x = abs(r[0, 0] * px + r[1, 0] * py + r[2, 0] * pz)
+        y = r[0, 1] * px + r[1, 1] * py + r[2, 1] * pz
+        z = r[0, 2] * px + r[1, 2] * py + r[2, 2] * pz
+        ok = x <= half_width and z >= z_lo and z <= z_hi
+        xs[i], ys[i], zs[i], inside[i] = x, y, z, ok
+        if ok:
+            lo = min(lo, y)
+            hi = max(hi, y)
+    return lo, hi
+
+
+@_jit
 def pad_contact_stats(
     points: np.ndarray,
     normals: np.ndarray,
@@ -302,24 +331,11 @@ def pad_contact_stats(
     Returns (B, 3) float64; a side without contact points gives -inf, pi and 0."""
     n = points.shape[0]
     out = np.empty((poses.shape[0], 3))
-    ys = np.empty(n)
-    zs = np.empty(n)
+    xs, ys, zs = np.empty(n), np.empty(n), np.empty(n)
     inside = np.zeros(n, dtype=np.bool_)
     for b in range(poses.shape[0]):
         r = poses[b]
-        lo, hi = np.inf, -np.inf
-        for i in range(n):
-            px, py, pz = points[i, 0] - r[0, 3], points[i, 1] - r[1, 3], points[i, 2] - r[2, 3]
-            x = r[0, 0] * px + r[1, 0] * py + r[2, 0] * pz
-            y = r[0, 1] * px + r[1, 1] * py + r[2, 1] * pz
-            z = r[0, 2] * px + r[1, 2] * py + r[2, 2] * pz
-            ok = abs(x) <= half_width and z >= z_lo and z <= z_hi
-            inside[i] = ok
-            ys[i] = y
-            zs[i] = z
-            if ok:
-                lo = min(lo, y)
-                hi = max(hi, y)
+        lo, hi = _pad_reach(r, points, half_width, z_lo, z_hi, xs, ys, zs, inside)
         depth, angle, share = np.inf, 0.0, 1.0
         for sign in (1.0, -1.0):
             count, in_area, sum_z, ny = 0, 0, 0.0, 0.0
@@ -346,6 +362,43 @@ def pad_contact_stats(
         out[b, 0] = depth
         out[b, 1] = angle
         out[b, 2] = share
+    return out
+
+
+@_jit
+def pad_edge_excess(
+    points: np.ndarray,
+    poses: np.ndarray,
+    half_width: float,
+    z_lo: float,
+    z_hi: float,
+    thickness: float,
+    clearance: float,
+) -> np.ndarray:
+    """Per grasp frame: how far the object reaches past a pad's contact plane within ``clearance`` of that
+    finger's side or tip faces, the larger of the two fingers', m (:func:`graspexp.planning.stability.
+    pad_edge_excess_m`). points : (N, 3) world; poses : (B, 4, 4). Returns (B,) float64, -inf where no
+    point lies there or no point is in the pads' reach."""
+    n = points.shape[0]
+    out = np.full(poses.shape[0], -np.inf)
+    xs, ys, zs = np.empty(n), np.empty(n), np.empty(n)
+    inside = np.zeros(n, dtype=np.bool_)
+    for b in range(poses.shape[0]):
+        r = poses[b]
+        lo, hi = _pad_reach(r, points, half_width, z_lo, z_hi, xs, ys, zs, inside)
+        if lo > hi:
+            continue
+        worst = -np.inf
+        for i in range(n):
+            x, z = xs[i], zs[i]
+            beside = x > half_width and x <= half_width + clearance and z >= z_lo and z <= z_hi + clearance
+            beyond = x <= half_width + clearance and z > z_hi and z <= z_hi + clearance
+            if not (beside or beyond):
+                continue
+            for past in (ys[i] - hi, lo - ys[i]):  # left finger beyond y = hi, right beyond y = lo
+                if past <= thickness + clearance:
+                    worst = max(worst, past)
+        out[b] = worst
     return out
 
 

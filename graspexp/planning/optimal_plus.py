@@ -27,9 +27,15 @@ is tried at several depths along its approach, and every try is checked as follo
    first ``shortlist`` passing paths are re-checked (collision with zero margin and pad depth) with the
    cloud moved by ``noise_samples`` motions drawn from the estimator's error about the object's
    origin; the paths passing in at least ``noise_min_pass`` of them (else those passing most often)
-   compete on the cost of 4.
+   compete.
+6. **Choice** (``choose_by``, ``edge_clearance_m``): ``cost``: the smallest cost of 4 wins;
+   ``edge_clearance``: the path whose fingers keep the most room from the object beside their side and
+   tip faces wins (:func:`graspexp.planning.stability.pad_edge_excess_m`: how far the object reaches past
+   either pad's contact plane within ``edge_clearance_m`` of them, counted from 0 so every path clear of
+   it ties), ties to the smallest cost of 4. The paper's cost ranks the paths the shortlist is drawn from;
+   within it, the grasp whose pads, not their edges, meet the object.
 
-6. **Area fallback** (``fallback_contacts_in_area``, ``fallback_modes``): in the modes listed, when no
+7. **Area fallback** (``fallback_contacts_in_area``, ``fallback_modes``): in the modes listed, when no
    path passes 1-3, the search is repeated requiring only the largest in-area share any try reached
    (the grasp touching the area most), if that share is at least ``fallback_contacts_in_area``;
    ``extras["in_area_required"]`` records the share required (``min_contacts_in_area`` when no
@@ -38,7 +44,7 @@ is tried at several depths along its approach, and every try is checked as follo
 Examination stops once ``shortlist`` paths pass 1-3. ``Grasp.n_feasible`` counts them; ``extras`` holds
 ``K``, ``M``, ``n_examined``, the rejections (``n_too_wide``, ``n_below_support``, ``n_collides``,
 ``n_weak_contact``, ``n_outside_area``), ``in_area_required``, ``pad_depth_m``, ``gravity_arm_m``,
-``depth_offset_m``, ``noise_pass`` and ``com_factor``. ``details`` holds the same keys as ``optimal``
+``depth_offset_m``, ``noise_pass``, ``com_factor`` and ``edge_excess_m``. ``details`` holds the same keys as ``optimal``
 where they apply (``cloud``, ``area_mask``, ``labels``, ``centers``, ``radii``, ``main_axis``, ``directions``, ``costs`` (K, M; the
 paper's, inf where removed by the plane test), ``best``, ``pose``, ``width``) plus ``com`` (3,).
 """
@@ -57,6 +63,7 @@ from graspexp.planning.request import PlanRequest, PlanResult
 from graspexp.planning.stability import (
     gravity_arm_m,
     pad_contacts,
+    pad_edge_excess_m,
     pose_perturbations,
     volume_centroid_m,
 )
@@ -121,6 +128,10 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
     costs = np.array([cand.costs[p[0], p[1]] for p in passed]) * factors
     noise_pass = _noise_pass(req, points, poses, widths, geometry, in_area_required)
     robust = noise_pass >= min(pl.noise_min_pass, noise_pass.max())
+    excess = pad_edge_excess_m(points, poses, geometry, pl.edge_clearance_m)
+    if pl.choose_by == "edge_clearance":  # step 6 of the module doc
+        room = np.where(robust, np.maximum(excess, 0.0), np.inf)
+        robust &= room == room.min()
     j = int(np.argmin(np.where(robust, costs, np.inf)))
     kb, pb, pose, width, depth, offset, roll_deg = passed[j]
     grasp = Grasp(
@@ -143,6 +154,7 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
             "gravity_arm_m": float(arms[j]),
             "com_factor": float(factors[j]),
             "noise_pass": float(noise_pass[j]),
+            "edge_excess_m": float(excess[j]),
         },
     )
     details = {

@@ -1,4 +1,5 @@
-"""What keeps a planned grasp in the hand once the object is lifted: pad depth, gravity arm, pose noise.
+"""What keeps a planned grasp in the hand once the object is lifted: pad depth, pad edges, gravity arm, pose
+noise.
 
 Pure numpy/scipy, world frame, metres. Grasp frames as in :mod:`.collision` (+Z approach, +Y closing
 axis, origin midway between the pads; the fingers span ``[root_z_m, tip_z_m]`` along Z).
@@ -11,6 +12,11 @@ axis, origin midway between the pads; the fingers span ``[root_z_m, tip_z_m]`` a
   along the approach. A grasp held by the fingertip edges (depth near 0) or on slopes is squeezed out
   when the pads press. A side's share in the area is the fraction of its contact points that are
   grasping-area points: where the pads will touch, whatever the grasp point was aimed at.
+- **Pad edges.** A finger closes until its pad face meets the extreme ``y`` of the points in its reach (its
+  contact plane). Where the object, within ``clearance_m`` of the finger's side faces (``|x|`` just past
+  ``fw/2``) or of its tip face (``z`` just past ``tip_z_m``), reaches past that plane, the finger meets it
+  with an edge: a surface that rises beside the pad, or a groove the finger sits in. A small shift or turn
+  of the object in the closing hand then presses the finger's side or tip face, not its pad, on it.
 - **Gravity arm.** Once the support is gone, gravity pulls at the centre of mass; its torque about the
   closing axis (the line through the grasp point along +Y) is resisted only by the pads' torsional
   friction. Its arm is ``|Y . ((g - o) x z_world)|``.
@@ -25,7 +31,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 from graspexp.config.gripper import GripperGeometry
 from graspexp.geometry import axis_angle_matrix
-from graspexp.planning.kernels import pad_contact_stats
+from graspexp.planning.kernels import pad_contact_stats, pad_edge_excess
 
 
 def volume_centroid_m(points_m: np.ndarray) -> np.ndarray:
@@ -90,6 +96,28 @@ def pad_contacts(
         band_m,
     )
     return stats[:, 0], stats[:, 1], stats[:, 2]
+
+
+def pad_edge_excess_m(
+    points_m: np.ndarray, poses: np.ndarray, geometry: GripperGeometry, clearance_m: float
+) -> np.ndarray:
+    """(B,) how far the object reaches past either pad's contact plane within ``clearance_m`` of that
+    finger's side and tip faces, m (module doc, "Pad edges"); -inf where nothing lies there. Points
+    farther past the plane than the finger's thickness plus ``clearance_m`` lie behind the finger and do
+    not count.
+
+    points_m : (N, 3) world cloud; poses : (B, 4, 4) world grasp frames. Compiled
+    (:func:`graspexp.planning.kernels.pad_edge_excess`).
+    """
+    return pad_edge_excess(
+        np.ascontiguousarray(points_m, dtype=np.float64),
+        np.ascontiguousarray(np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)),
+        geometry.finger_width_m / 2,
+        geometry.root_z_m,
+        geometry.tip_z_m,
+        geometry.finger_thickness_m,
+        clearance_m,
+    )
 
 
 def pose_error(rng: np.random.Generator, trans_mm: float, rot_deg: float) -> tuple[np.ndarray, np.ndarray]:
