@@ -120,6 +120,16 @@ ABLATIONS: tuple[Reading, ...] = (
         (*PLUS, "planner.fallback_modes=[collab,bin]"),
         "optimal_plus, the area fallback in collab mode too",
     ),
+    Reading(
+        "plus_choose_cost",
+        (*PLUS, "planner.choose_by=cost"),
+        "optimal_plus, the paper's cost picks the grasp (no edge clearance)",
+    ),
+    Reading(
+        "plus_no_arm_settle",
+        (*PLUS, "sim.approach_settle_s=0"),
+        "optimal_plus, fingers close as the approach ends (no arm settle)",
+    ),
     Reading("plus_n2048", (*PLUS, "planner.n_points=2048"), "optimal_plus with a 2048-point cloud"),
     Reading("plus_no_com", (*PLUS, "planner.com_weight=0"), "optimal_plus without the gravity-arm factor"),
     Reading(

@@ -46,7 +46,10 @@ Examination stops once ``shortlist`` paths pass 1-3. ``Grasp.n_feasible`` counts
 ``n_weak_contact``, ``n_outside_area``), ``in_area_required``, ``pad_depth_m``, ``gravity_arm_m``,
 ``depth_offset_m``, ``noise_pass``, ``com_factor`` and ``edge_excess_m``. ``details`` holds the same keys as ``optimal``
 where they apply (``cloud``, ``area_mask``, ``labels``, ``centers``, ``radii``, ``main_axis``, ``directions``, ``costs`` (K, M; the
-paper's, inf where removed by the plane test), ``best``, ``pose``, ``width``) plus ``com`` (3,).
+paper's, inf where removed by the plane test), ``best``, ``pose``, ``width``) plus ``com`` (3,) and the S
+shortlisted paths' ``shortlist_poses`` (S, 4, 4), ``shortlist_widths`` (S,) m, ``shortlist_costs`` (S,, step
+4), ``shortlist_robust`` (S,) bool, ``shortlist_edge_excess_m`` (S,) and ``shortlist_pad_depth_m`` (S,)
+(:mod:`graspexp.bench.shortlist` simulates each of them).
 """
 
 import numpy as np
@@ -129,10 +132,7 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
     noise_pass = _noise_pass(req, points, poses, widths, geometry, in_area_required)
     robust = noise_pass >= min(pl.noise_min_pass, noise_pass.max())
     excess = pad_edge_excess_m(points, poses, geometry, pl.edge_clearance_m)
-    if pl.choose_by == "edge_clearance":  # step 6 of the module doc
-        room = np.where(robust, np.maximum(excess, 0.0), np.inf)
-        robust &= room == room.min()
-    j = int(np.argmin(np.where(robust, costs, np.inf)))
+    j = pick_shortlisted(pl.choose_by, costs, robust, excess)
     kb, pb, pose, width, depth, offset, roll_deg = passed[j]
     grasp = Grasp(
         pose=pose,
@@ -170,8 +170,23 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
         "best": np.array([kb, pb]),
         "pose": pose,
         "width": np.float64(width),
+        "shortlist_poses": poses,
+        "shortlist_widths": widths,
+        "shortlist_costs": costs,
+        "shortlist_robust": robust,
+        "shortlist_edge_excess_m": excess,
+        "shortlist_pad_depth_m": np.array([p[4] for p in passed]),
     }
     return PlanResult(grasp=grasp, details=details)
+
+
+def pick_shortlisted(choose_by: str, costs: np.ndarray, robust: np.ndarray, excess_m: np.ndarray) -> int:
+    """Step 6 of the module doc: the index of the grasp among (S,) shortlisted paths with costs ``costs``
+    (step 4), noise-robust flags ``robust`` (step 5, at least one set) and edge excesses ``excess_m``, m."""
+    if choose_by == "edge_clearance":
+        room = np.where(robust, np.maximum(excess_m, 0.0), np.inf)
+        robust = robust & (room == room.min())
+    return int(np.argmin(np.where(robust, costs, np.inf)))
 
 
 def _search_paths(
