@@ -102,10 +102,12 @@ def test_plan_cli_unknown_object_is_one_line_and_non_zero():
     assert len(lines) == 1 and lines[0].startswith("graspexp.plan: error: ") and "teapot" in lines[0]
 
 
-def test_figures_cli_writes_the_pngs(tmp_path):
+@pytest.mark.parametrize("planner", ["optimal", "optimal_plus"])
+def test_figures_cli_writes_the_pngs(tmp_path, planner):
     from graspexp.figures import main as figures_main
 
-    assert figures_main(["dataset=primitives", "--object", "mug", "--out", str(tmp_path)]) == 0
+    args = ["dataset=primitives", f"planner={planner}", "--object", "mug", "--out", str(tmp_path)]
+    assert figures_main(args) == 0
     names = sorted(p.name for p in tmp_path.glob("*.png"))
     assert names == [
         "fig03_cloud.png",

@@ -46,7 +46,8 @@ Examination stops once ``shortlist`` paths pass 1-3. ``Grasp.n_feasible`` counts
 ``n_weak_contact``, ``n_outside_area``), ``in_area_required``, ``pad_depth_m``, ``gravity_arm_m``,
 ``depth_offset_m``, ``noise_pass``, ``com_factor`` and ``edge_excess_m``. ``details`` holds the same keys as ``optimal``
 where they apply (``cloud``, ``area_mask``, ``labels``, ``centers``, ``radii``, ``main_axis``, ``directions``, ``costs`` (K, M; the
-paper's, inf where removed by the plane test), ``best``, ``pose``, ``width``) plus ``com`` (3,) and the S
+paper's, inf where removed by the plane test), ``feasible`` (K, M), ``pose_axis``, ``best``, ``pose``, ``width``,
+``mode``, ``table_z``, ``sphere_radius``, ``gripper_max_width``) plus ``com`` (3,) and the S
 shortlisted paths' ``shortlist_poses`` (S, 4, 4), ``shortlist_widths`` (S,) m, ``shortlist_costs`` (S,, step
 4), ``shortlist_robust`` (S,) bool, ``shortlist_edge_excess_m`` (S,) and ``shortlist_pad_depth_m`` (S,)
 (:mod:`graspexp.bench.shortlist` simulates each of them).
@@ -164,12 +165,18 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
         "centers": cand.clusters.centers_m,
         "radii": cand.clusters.radii_m,
         "main_axis": cand.axis,
+        "pose_axis": cand.pose_axis,
         "directions": cand.directions,
         "costs": cand.costs,
+        "feasible": cand.feasible,
         "com": com,
         "best": np.array([kb, pb]),
         "pose": pose,
         "width": np.float64(width),
+        "mode": np.str_(req.mode),
+        "table_z": np.float64(req.table_z),
+        "sphere_radius": np.float64(pl.sphere_radius_m),
+        "gripper_max_width": np.float64(gr.max_width_m),
         "shortlist_poses": poses,
         "shortlist_widths": widths,
         "shortlist_costs": costs,
