@@ -43,12 +43,12 @@ EXCESS_BANDS_MM = (-np.inf, 0.0, 0.5, 1.0, 2.0, 4.0, np.inf)
 
 
 def _forced(j: int, seen: dict):
-    """A planner that plans as ``optimal_plus`` and returns its ``j``-th shortlisted grasp; the plan's
-    details go into ``seen["details"]``."""
+    """A planner that returns ``optimal_plus``'s ``j``-th shortlisted grasp. The drop, so the request, is
+    the same in every trial of one drop: the plan is made in the first and kept in ``seen["plan"]``."""
 
     def planner(req):
-        res = plan(req)
-        d = seen.setdefault("details", res.details)
+        res = seen.get("plan") or seen.setdefault("plan", plan(req))
+        d = res.details
         grasp = dataclasses.replace(
             res.grasp, pose=d["shortlist_poses"][j], width_m=float(d["shortlist_widths"][j])
         )
@@ -75,9 +75,9 @@ def _job(args: tuple[list[str], str, int]) -> list[dict]:
                 plain, model, hulls, i, seed, NullRecorder(), plan=_forced(j, seen), quality=fc_min_mu
             )
             res = run_trial(ctx)
-            d = seen.get("details")
-            if d is None:  # no grasp planned for this drop: nothing to compare
+            if "plan" not in seen:  # no grasp planned for this drop: nothing to compare
                 break
+            d = seen["plan"].details
             n = len(d["shortlist_costs"])
             rows.append(
                 {
