@@ -73,7 +73,7 @@ NOISE_LEVELS: tuple[tuple[float, float], ...] = ((10.0, 0.0), (20.0, 0.0), (0.0,
 """Pose-noise levels (translation std mm, rotation std degrees) run besides zero, as in ``nox -s compare``."""
 IN_AREA_NOTE = (
     "In-area contact %: share of the finger-object contacts at the end of closing that lie within "
-    f"{IN_AREA_TOLERANCE_M * 1000:g} mm of a grasping-area point of the object's cloud "
+    f"{IN_AREA_TOLERANCE_M * 1000:g} mm of a grasping-area point of the object's reference cloud "
     "(graspexp/report/contact_area.py; from each log's /contacts and /tf), over the trials whose fingers "
     "touch the object then. Trials all in area %: share of those trials whose every contact is in the area. "
     "Success in area: successful trials whose every contact is in the area (the hand-over task's success)."

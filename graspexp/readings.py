@@ -50,6 +50,21 @@ READINGS: tuple[Reading, ...] = (
     Reading(
         "no_section_fit", ("planner=optimal", "planner.section_fit=false"), "least cost wins, no section test"
     ),
+    Reading(
+        "no_swept_check",
+        ("planner=optimal", "planner.swept_check=false"),
+        "no swept check: fingers and palm may meet the object or the table",
+    ),
+    Reading(
+        "no_area_rule",
+        ("planner=optimal", "planner.min_contacts_in_area=0"),
+        "no area rule: the pads may land outside the grasping area",
+    ),
+    Reading(
+        "bin_fallback",
+        ("planner=optimal", "planner.fallback_contacts_in_area=0"),
+        "bin: the grasp touching the area most when none is inside it",
+    ),
     Reading("no_margin", ("planner=optimal", "planner.width_margin=0"), "opening = 2 r_k exactly"),
     Reading(
         "pose_axis_area", ("planner=optimal", "planner.pose_axis=area"), "grasp X = the area's main axis"

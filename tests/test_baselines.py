@@ -12,6 +12,7 @@ from graspexp.config.gripper import GripperGeometry
 from graspexp.planning import Grasp, NoFeasibleGrasp, PlanRequest, get_planner, plan
 from graspexp.planning.antipodal import antipodal_pairs
 from graspexp.planning.collision import cloud_hits, frame_from_axes, lowest_z
+from graspexp.planning.stability import pad_contacts
 
 MINE = ("antipodal", "obb", "random", "optimal_plus")
 TABLE_Z = 0.1
@@ -159,34 +160,89 @@ def _plan_with(name: str, pts, normals, area, seed: int = 1, *extra: str) -> Gra
     ).grasp
 
 
-def test_optimal_plus_avoids_the_palm_collision_that_optimal_accepts() -> None:
+PAPER_SWEEP_VARIANTS = {
+    "no_checks": ("optimal", "planner.swept_check=false", "planner.min_contacts_in_area=0"),
+    "swept_only": ("optimal", "planner.min_contacts_in_area=0"),
+    "optimal": ("optimal",),
+    "optimal_plus": ("optimal_plus",),
+}
+"""The paper's planner without its swept check and area rule, with the swept check alone, as configured
+(both), and optimal_plus."""
+CHECKED = ("swept_only", "optimal", "optimal_plus")
+
+
+def test_the_swept_check_keeps_the_palm_out_of_the_object() -> None:
     # A can (r 33 mm, 100 mm tall) whose grasping area is its lower 60 mm: depending on the K-means seed the
-    # paper's planner grasps the area's centre nearly straight from above, with the palm inside the can.
+    # paper's planner without the checks grasps the area's centre nearly straight from above, with the palm inside
+    # the can.
     pts, normals = _cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
     area = pts[:, 2] < TABLE_Z + 0.06
-    hits = {name: [] for name in ("optimal", "optimal_plus")}
+    hits = {name: [] for name in PAPER_SWEEP_VARIANTS}
     for seed in range(8):
-        for name, found in hits.items():
-            g = _plan_with(name, pts, normals, area, seed)
+        for name, (planner, *extra) in PAPER_SWEEP_VARIANTS.items():
+            g = _plan_with(planner, pts, normals, area, seed, *extra)
+            found = hits[name]
             found.append(cloud_hits(pts, g.pose[None], RG2, g.width_m, sweep_m=0.1, margin_m=0.0)[0])
-    assert sum(h > 0 for h in hits["optimal"]) >= 3
-    assert not any(hits["optimal_plus"])
+    assert sum(h > 0 for h in hits["no_checks"]) >= 3
+    assert not any(h for name in CHECKED for h in hits[name])
 
 
-def test_optimal_plus_keeps_the_fingers_out_of_the_table_where_optimal_does_not() -> None:
+def test_the_swept_check_keeps_the_fingers_out_of_the_table() -> None:
     # The same can, whole surface as area, cut into clusters half a stroke long (K = 2): on some K-means
-    # seeds the paper's planner closes from the side on the lower cluster so low that the lower finger
-    # corner dips below the table top (only its sphere point is tested).
+    # seeds the paper's planner without the checks closes from the side on the lower cluster so low that the lower
+    # finger corner dips below the table top (only its sphere point is tested).
     pts, normals = _cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
     area = np.ones(len(pts), bool)
-    low = {name: [] for name in ("optimal", "optimal_plus")}
+    low = {name: [] for name in PAPER_SWEEP_VARIANTS}
     half = ("planner.auto_k_stroke_fraction=0.5", "planner.cluster_radius=rms")
     for seed in range(8):
-        for name, found in low.items():
-            g = _plan_with(name, pts, normals, area, seed, *half)
-            found.append(lowest_z(g.pose[None], RG2, g.width_m, 0.1)[0])
-    assert sum(z < TABLE_Z for z in low["optimal"]) >= 2
-    assert min(low["optimal_plus"]) >= TABLE_Z
+        for name, (planner, *extra) in PAPER_SWEEP_VARIANTS.items():
+            g = _plan_with(planner, pts, normals, area, seed, *half, *extra)
+            low[name].append(lowest_z(g.pose[None], RG2, g.width_m, 0.1)[0])
+    assert sum(z < TABLE_Z for z in low["no_checks"]) >= 2
+    assert min(z for name in CHECKED for z in low[name]) >= TABLE_Z
+
+
+def _pad_share(pts, normals, area, g: Grasp) -> float:
+    """The smaller pad's share of contact points in ``area`` for the planned grasp (contact band 4 mm)."""
+    return float(pad_contacts(pts, normals, g.pose[None], GripperGeometry.of(RG2), 0.004, area)[2][0])
+
+
+def test_the_area_rule_keeps_the_paper_planners_pads_in_the_area() -> None:
+    # The can with its lower 60 mm as the area, swept check off to isolate the rule: without it the pads
+    # of some grasps reach the can's upper part, with it every grasp's pad contacts are area points.
+    pts, normals = _cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
+    area = pts[:, 2] < TABLE_Z + 0.06
+    shares = {"off": [], "on": []}
+    for seed in range(8):
+        for name, share in (("off", 0), ("on", 1)):
+            g = _plan_with(
+                "optimal",
+                pts,
+                normals,
+                area,
+                seed,
+                "planner.swept_check=false",
+                f"planner.min_contacts_in_area={share}",
+            )
+            shares[name].append(_pad_share(pts, normals, area, g))
+            if share:
+                assert g.extras["in_area_required"] == 1.0
+    assert sum(s < 1.0 for s in shares["off"]) >= 3
+    assert min(shares["on"]) == 1.0
+
+
+def test_the_paper_planner_grasps_outside_the_area_only_through_the_fallback() -> None:
+    # A 4 mm high ring at the can's base as the area: every pad touching it also touches the wall above.
+    pts, normals = _cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
+    area = pts[:, 2] < TABLE_Z + 0.004
+    with pytest.raises(NoFeasibleGrasp, match=r"has less than 1.0 of a pad's contact in the grasping area"):
+        _plan_with("optimal", pts, normals, area, 1, "planner.swept_check=false")
+    g = _plan_with(
+        "optimal", pts, normals, area, 1, "planner.swept_check=false", "planner.fallback_contacts_in_area=0"
+    )
+    assert g.extras["in_area_required"] < 1.0
+    assert _pad_share(pts, normals, area, g) == pytest.approx(g.extras["in_area_required"])
 
 
 def test_cloud_hits_counts_points_in_fingers_and_palm_only() -> None:

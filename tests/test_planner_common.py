@@ -37,6 +37,32 @@ def box_cloud(rng: np.random.Generator, n: int, size_m: tuple[float, float, floa
     return pts
 
 
+PAPER_STEPS_ONLY = {"swept_check": False, "min_contacts_in_area": 0.0}
+"""``OptimalConfig`` keys that switch off the checks the paper does not print (swept gripper, area rule),
+for tests of the paper's own steps."""
+
+
+def upright_request(model, pose: np.ndarray, mode: str, planner: OptimalConfig) -> PlanRequest:
+    """A request for a loaded object (``graspexp.datasets.ObjectModel``) standing in its (4, 4)
+    ``upright_pose`` on the plane z = 0.1 m, planner seed 1."""
+    return PlanRequest(
+        points=model.points + pose[:3, 3],
+        normals=model.normals,
+        area_mask=model.area_mask,
+        object_pose=pose,
+        table_z=UPRIGHT_SUPPORT_Z,
+        mode=mode,
+        gripper=RG2,
+        planner=planner,
+        cost=CostConfig(),
+        seed=1,
+    )
+
+
+UPRIGHT_SUPPORT_Z = 0.1
+"""Height of the support plane of :func:`upright_request`, m."""
+
+
 def request(
     points: np.ndarray,
     area_mask: np.ndarray,

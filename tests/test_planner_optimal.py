@@ -6,11 +6,12 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from test_planner_common import RG2, box_cloud, cylinder_cloud, request
+from test_planner_common import PAPER_STEPS_ONLY, RG2, box_cloud, cylinder_cloud, request
 
 from graspexp.config import OptimalConfig
 from graspexp.geometry import quat_wxyz_to_matrix
 from graspexp.planning import NoFeasibleGrasp, UnknownPlanner, get_planner, plan, plan_optimal
+from graspexp.planning.collision import cloud_hits, lowest_z
 
 DETAIL_KEYS = {
     "cloud",
@@ -156,7 +157,7 @@ def test_object_wider_than_the_gripper_raises():
     rng = np.random.default_rng(6)
     u = rng.normal(size=(1500, 3))
     ball = 0.1 * u / np.linalg.norm(u, axis=1, keepdims=True)  # 200 mm ball: every section > 110 mm
-    one = OptimalConfig(name="optimal", m=64, k=1)
+    one = OptimalConfig(name="optimal", m=64, k=1, **PAPER_STEPS_ONLY)  # the palm would be in the ball
     with pytest.raises(NoFeasibleGrasp, match="wider than the gripper"):
         plan_optimal(request(ball, np.ones(len(ball), dtype=bool), table_z=-1.0, planner=one))
     big = dataclasses.replace(RG2, max_width_m=0.25)
@@ -216,7 +217,7 @@ def test_opening_is_widened_when_no_section_fits_the_cluster_radius():
         (np.abs(pts[:, 0] - 0.03) < 1e-9) & (np.abs(pts[:, 1]) < 0.004) & (np.abs(pts[:, 2] - 0.03) < 0.004)
     )
     assert 0 < mask.sum() < 30  # a tiny patch: r_k of a few mm, opening far below any section
-    req = request(pts, mask, table_z=-1.0, planner=OptimalConfig(name="optimal", m=64))
+    req = request(pts, mask, table_z=-1.0, planner=OptimalConfig(name="optimal", m=64, **PAPER_STEPS_ONLY))
     res = plan_optimal(req)
     _check_result(res, req)
     g = res.grasp
@@ -266,6 +267,8 @@ unit_quat = st.tuples(*[st.floats(-1.0, 1.0) for _ in range(4)]).filter(
 def test_property_valid_grasp_for_random_clouds_and_poses(
     shape, dims, n, quat, table_z, xy, mode, band, seed
 ):
+    """The paper's steps alone always give a grasp; with the swept check and the area rule (the defaults)
+    a grasp, when there is one, is clear of the cloud and the support and has its pads in the area."""
     rng = np.random.default_rng(seed)
     if shape == "cylinder":
         obj = cylinder_cloud(rng, n, radius_m=dims[0], height_m=2 * dims[1])
@@ -281,7 +284,23 @@ def test_property_valid_grasp_for_random_clouds_and_poses(
     mask = (proj >= lo) & (proj <= hi)
     mask[int(np.argmin(np.abs(proj - (lo + hi) / 2)))] = True
     req = request(
-        world, mask, table_z=table_z, mode=mode, seed=seed % 1000, planner=OptimalConfig(name="optimal", m=64)
+        world,
+        mask,
+        table_z=table_z,
+        mode=mode,
+        seed=seed % 1000,
+        planner=OptimalConfig(name="optimal", m=64, **PAPER_STEPS_ONLY),
     )
     res = plan_optimal(req)
     _check_result(res, req)
+    checked = dataclasses.replace(req, planner=OptimalConfig(name="optimal", m=64))
+    try:
+        res = plan_optimal(checked)
+    except NoFeasibleGrasp as e:
+        assert "planner.swept_check" in str(e) or "grasping area" in str(e)
+        return
+    _check_result(res, checked)
+    g = res.grasp
+    assert cloud_hits(world, g.pose[None], RG2, g.width_m, sweep_m=0.1, margin_m=0.0)[0] == 0
+    assert lowest_z(g.pose[None], RG2, g.width_m, 0.1)[0] >= table_z
+    assert res.details["contact_share"][g.cluster, g.path] == 1.0

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from conftest import compose_cfg
 from omegaconf import OmegaConf
-from test_planner_common import RG2, cylinder_cloud, request
+from test_planner_common import PAPER_STEPS_ONLY, RG2, cylinder_cloud, request
 
 from graspexp.config import OptimalConfig
 from graspexp.planning import plan_optimal
@@ -51,7 +51,7 @@ def test_grasp_point_centre_keeps_c_k_and_section_middle_moves_along_y_only():
 
 def test_without_the_section_fit_the_cheapest_path_wins_even_if_the_object_is_wider():
     # Opening 2 r_k with r_k the RMS radius and no margin: far too narrow for the can's 66 mm section.
-    keys = {"cluster_radius": "rms", "width_margin": 0.0, "k": 3}
+    keys = {"cluster_radius": "rms", "width_margin": 0.0, "k": 3, **PAPER_STEPS_ONLY}
     fit, printed = _plan(section_fit=True, **keys), _plan(section_fit=False, **keys)
     costs = printed.details["costs"]
     assert printed.grasp.cost == costs.min()
@@ -78,13 +78,22 @@ def test_pose_axis_sets_the_grasp_x_axis_and_main_axis_the_cost_angle():
 def test_presets_differ_only_in_the_documented_reading_keys():
     ours, literal = compose_cfg("planner=optimal").planner, compose_cfg("planner=optimal_literal").planner
     differ = {k for k in ours if ours[k] != literal[k]}
-    assert differ == {"name", "pose_axis", "grasp_point", "section_fit", "width_margin"}
+    assert differ == {
+        "name",
+        "pose_axis",
+        "grasp_point",
+        "section_fit",
+        "width_margin",
+        "swept_check",
+        "min_contacts_in_area",
+    }
     assert (literal.pose_axis, literal.grasp_point, literal.section_fit, literal.width_margin) == (
         "area",
         "centre",
         False,
         0.0,
     )
+    assert (literal.swept_check, literal.min_contacts_in_area) == (False, 0.0)
 
 
 def test_literal_preset_plans_the_printed_argmin_at_c_k():

@@ -6,14 +6,15 @@ import sys
 
 import numpy as np
 import pytest
-from test_planner_common import RG2
+from test_planner_common import PAPER_STEPS_ONLY, RG2, UPRIGHT_SUPPORT_Z, upright_request
 
 from graspexp.cli import compose_config
-from graspexp.config import CostConfig, DatasetConfig, OptimalConfig
+from graspexp.config import DatasetConfig, OptimalConfig
 from graspexp.datasets import dataset_objects, load_object
 from graspexp.datasets.catalog import candidate_paths, dataset_spec
 from graspexp.plan import main as plan_main
-from graspexp.planning import PlanRequest, plan
+from graspexp.planning import NoFeasibleGrasp, plan
+from graspexp.planning.collision import cloud_hits, lowest_z
 from graspexp.planning.upright import upright_pose
 
 
@@ -26,41 +27,49 @@ def _present(root, dataset):
 
 @pytest.mark.parametrize("dataset", ["ycb", "linemod"])
 def test_plan_every_real_object_in_both_modes(data_root, dataset):
+    """The paper's steps alone plan every object upright in both modes; with the swept check and the
+    area rule (the defaults) a grasp, where there is one, keeps the gripper clear and its pads in the
+    area, and the rest fail with the check that rejected them named."""
     cfg, names = _present(data_root, dataset)
     if not names:
         pytest.skip(f"no {dataset} mesh under {data_root}")
-    support_z = 0.1
+    support_z = UPRIGHT_SUPPORT_Z
+    planned = 0
     for name in names:
         model = load_object(cfg, name, 2048, 0)
         pose = upright_pose(model, support_z)
         pts = model.points + pose[:3, 3]
         assert pts[:, 2].min() >= support_z - 1e-9
         for mode in ("collab", "bin"):
-            req = PlanRequest(
-                points=pts,
-                normals=model.normals,
-                area_mask=model.area_mask,
-                object_pose=pose,
-                table_z=support_z,
-                mode=mode,
-                gripper=RG2,
-                planner=OptimalConfig(name="optimal"),
-                cost=CostConfig(),
-                seed=1,
-            )
-            res = plan(req)
-            g, det = res.grasp, res.details
-            R = g.pose[:3, :3]
-            np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-9, err_msg=f"{name} {mode}")
-            assert np.linalg.det(R) == pytest.approx(1.0, abs=1e-9)
-            assert np.isfinite(g.cost) and g.n_feasible > 0, (name, mode)
-            start = g.position - 0.1 * g.approach
-            assert start[2] >= support_z, (name, mode)
-            assert RG2.min_width_m <= g.width_m <= RG2.max_width_m
-            assert det["area_mask"].sum() > 0
-            # The grasp point is the centre of a cluster of area points, so it is near the area.
-            area = pts[model.area_mask]
-            assert np.min(np.linalg.norm(area - g.position, axis=1)) < 0.06, (name, mode)
+            for checked in (False, True):
+                keys = {} if checked else PAPER_STEPS_ONLY
+                req = upright_request(model, pose, mode, OptimalConfig(name="optimal", **keys))
+                try:
+                    res = plan(req)
+                except NoFeasibleGrasp as e:
+                    assert checked and ("planner.swept_check" in str(e) or "grasping area" in str(e)), (
+                        name,
+                        e,
+                    )
+                    continue
+                planned += checked
+                g, det = res.grasp, res.details
+                R = g.pose[:3, :3]
+                np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-9, err_msg=f"{name} {mode}")
+                assert np.linalg.det(R) == pytest.approx(1.0, abs=1e-9)
+                assert np.isfinite(g.cost) and g.n_feasible > 0, (name, mode)
+                start = g.position - 0.1 * g.approach
+                assert start[2] >= support_z, (name, mode)
+                assert RG2.min_width_m <= g.width_m <= RG2.max_width_m
+                assert det["area_mask"].sum() > 0
+                # The grasp point is the centre of a cluster of area points, so it is near the area.
+                area = pts[model.area_mask]
+                assert np.min(np.linalg.norm(area - g.position, axis=1)) < 0.06, (name, mode)
+                if checked:
+                    assert cloud_hits(pts, g.pose[None], RG2, g.width_m, sweep_m=0.1, margin_m=0.0)[0] == 0
+                    assert lowest_z(g.pose[None], RG2, g.width_m, 0.1)[0] >= support_z, (name, mode)
+                    assert det["contact_share"][g.cluster, g.path] == 1.0, (name, mode)
+    assert planned > 0
 
 
 def test_plan_cli_prints_one_json_object_and_dumps(tmp_path, capsys, monkeypatch):

@@ -17,16 +17,23 @@ object pose: world frame, metres):
    modes (the plane is the box top in collab mode, the table top in bin mode; Fig. 8);
 6. cost Eq. (1) (collab) or Eq. (2)-(3) (bin) of every remaining path (:mod:`.cost`); removed paths
    cost ``inf``;
-7. ``planner.section_fit`` false: the path of least cost wins (as printed). True: paths are taken in
-   ascending cost (stable order: cluster-major, then path index) and the first whose object section
-   between the pads (:func:`.pose.slab_spans_m`, extent ``y_hi - y_lo``) fits its opening
-   ``w_k = clip(2 r_k (1 + width_margin), min_width, max_width)`` wins. Checking lazily in cost order
-   picks exactly the argmin over the paths passing both tests; examined paths that fail get cost ``inf``
-   and ``feasible`` False, unexamined ones keep their table verdict. If no path's section fits its
-   ``w_k`` (all were then examined), the cheapest path whose section fits the stroke ``max_width`` is
-   taken and the opening is widened to ``clip(section (1 + width_margin), min_width, max_width)``
-   (``extras["widened"]``); if none fits the stroke either:
-   ``NoFeasibleGrasp("object wider than the gripper ...")``;
+7. paths are taken in ascending cost (stable order: cluster-major, then path index) and the first that
+   passes every test switched on wins; with none on (as printed) that is the path of least cost.
+   ``planner.section_fit``: the object's section between the pads (:func:`.pose.slab_spans_m`, extent
+   ``y_hi - y_lo``) fits its opening ``w_k = clip(2 r_k (1 + width_margin), min_width, max_width)``;
+   ``planner.swept_check``: the fingers and palm opened to the path's width, swept from the sphere point
+   to the grasp pose, meet no cloud point and, where ``req.support_blocks_gripper``, stay above the
+   support (:mod:`.collision`, margin 0; ``extras["n_collides"]``); ``planner.min_contacts_in_area``
+   > 0: at least that share of each pad's contact points are grasping-area points
+   (:func:`.stability.pad_contacts`; ``extras["n_outside_area"]``, ``extras["in_area_required"]``).
+   Checking lazily in cost order picks exactly the argmin over the paths passing every test; examined
+   paths that fail get cost ``inf`` and ``feasible`` False, unexamined ones keep their table verdict.
+   If none passes (all were then examined): the cheapest path whose section fits the stroke
+   ``max_width`` (and passes the other tests) is taken with its opening widened to
+   ``clip(section (1 + width_margin), min_width, max_width)`` (``extras["widened"]``); in the modes of
+   ``planner.fallback_modes`` the area rule is relaxed to the largest share reached, if at least
+   ``planner.fallback_contacts_in_area`` (:mod:`.area_rule`). Otherwise :class:`NoFeasibleGrasp`
+   names the test: "object wider than the gripper ...", the swept check, or the grasping area;
 8. pose per Fig. 9 and opening width ``w_k`` (:mod:`.pose`); the origin is ``c_k``
    (``planner.grasp_point: centre``) or ``c_k`` moved along the closing axis Y to the middle of the
    section (``section_middle``; ``extras["centre_shift_m"]``), since the pads close symmetrically.
@@ -35,21 +42,25 @@ object pose: world frame, metres):
 ``area_mask``, ``labels`` (K-means label of each area point), ``centers``, ``radii`` (m), ``main_axis``,
 ``pose_axis``, ``directions`` (K, M, 3), ``feasible`` (K, M), ``costs`` (K, M; inf where infeasible),
 ``section_width`` (K, M; m, nan where not examined), ``section_span`` (K, M, 2; [y_lo, y_hi] about c_k,
-m), ``best`` (k, p), ``pose``, ``width``, ``mode``, ``table_z``, ``sphere_radius`` and
+m), ``contact_share`` (K, M; the smaller pad's in-area share, nan where not examined or the rule is
+off), ``best`` (k, p), ``pose``, ``width``, ``mode``, ``table_z``, ``sphere_radius`` and
 ``gripper_max_width``."""
 
 from dataclasses import dataclass, replace
 
 import numpy as np
 
-from graspexp.config import GripperConfig
+from graspexp.config.gripper import GripperGeometry
 from graspexp.geometry import make_pose
+from graspexp.planning.area_rule import fallback_share, no_grasp_in_area
 from graspexp.planning.clusters import Clusters, choose_k, main_axis, max_radii_m, segment
+from graspexp.planning.collision import cloud_hits, lowest_z
 from graspexp.planning.cost import all_path_costs
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.paths import above_support, approach_directions
 from graspexp.planning.pose import grasp_rotation, grasp_rotations, opening_widths_m, slab_spans_m
 from graspexp.planning.request import PlanRequest, PlanResult
+from graspexp.planning.stability import pad_contacts
 from graspexp.seeding import derive_seed
 
 NAME = "optimal"
@@ -164,8 +175,8 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
     Raises
     ------
     NoFeasibleGrasp
-        Empty grasping area; every path crosses the support plane; or every remaining path finds the
-        object wider than the gripper's stroke.
+        Empty grasping area; every path crosses the support plane; or no remaining path passes the
+        tests of step 7 even after its fallbacks.
     """
     cand = paper_candidates(req, req.planner.name)
     pl, gr = req.planner, req.gripper
@@ -179,25 +190,18 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
     )
     k, m = costs.shape
     openings = opening_widths_m(radii, pl.width_margin, gr)  # (K,) m
-    spans = np.full((k, m, 2), np.nan)  # [y_lo, y_hi] of the section between the pads (nan: not examined)
-    section = np.full((k, m), np.nan)  # its extent, m
-    if pl.section_fit:
-        best, best_rotation, widened = _cheapest_fitting(cand, openings, spans, section, gr)
-    else:  # the printed argmin of the cost over the paths above the support
-        flat = int(np.argmin(costs))
-        best, widened = (flat // m, flat % m), False
-        best_rotation = grasp_rotation(directions[best], cand.pose_axis)
-        spans[best] = slab_spans_m(points, centers[best[0]], best_rotation[None], gr)[0]
-        section[best] = spans[best][1] - spans[best][0]
-    if not pl.section_fit:
-        fits = feasible
-    elif widened:
-        fits = feasible & (section <= gr.max_width_m)
-    else:  # unexamined paths keep their table verdict
-        fits = feasible & ~(section > openings[:, None])
-    n_too_wide = int((feasible & ~fits).sum())
-    feasible &= fits
+    tests = PathTests.empty(k, m)
+    best, best_rotation, need = _choose_path(req, cand, openings, tests)
+    examined = ~np.isnan(tests.section)
+    widened = bool(pl.section_fit and tests.section[best] > openings[best[0]])
+    limits = gr.max_width_m if widened else openings[:, None]
+    too_wide = examined & (tests.section > limits) if pl.section_fit else np.zeros_like(examined)
+    collides = examined & ~too_wide & ~tests.free
+    outside = examined & ~too_wide & ~collides & (tests.share < need)
+    n_too_wide, n_collides, n_outside = (int((feasible & t).sum()) for t in (too_wide, collides, outside))
+    feasible &= ~(too_wide | collides | outside)
     costs[~feasible] = np.inf
+    spans, section = tests.spans, tests.section
 
     kb, pb = best
     slab_extent = float(section[kb, pb])
@@ -222,6 +226,8 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
             "slab_extent_m": slab_extent,
             "centre_shift_m": shift_m,
             "widened": widened,
+            **({"n_collides": n_collides} if pl.swept_check else {}),
+            **({"n_outside_area": n_outside, "in_area_required": float(need)} if need > 0 else {}),
         },
     )
     details = {
@@ -237,6 +243,7 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
         "costs": costs,
         "section_width": section,
         "section_span": spans,
+        "contact_share": tests.share,
         "best": np.array([kb, pb]),
         "pose": pose,
         "width": np.float64(width),
@@ -248,16 +255,41 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
     return PlanResult(grasp=grasp, details=details)
 
 
-def _cheapest_fitting(
-    cand: Candidates, openings: np.ndarray, spans: np.ndarray, section: np.ndarray, gr: GripperConfig
-) -> tuple[tuple[int, int], np.ndarray, bool]:
-    """Step 7 with ``planner.section_fit``: the cheapest path whose section fits its opening.
+@dataclass(frozen=True)
+class PathTests:
+    """Step 7's tests of the paths examined (nan / True where not examined), each (K, M) unless noted.
 
-    Fills ``spans`` (K, M, 2) and ``section`` (K, M) for the paths examined, in place. Returns the
-    (cluster, path) chosen, its (3, 3) rotation and whether the fallback (open to the section) was taken.
+    spans : (K, M, 2) [y_lo, y_hi] of the object's section between the pads about c_k, m; section : its
+    extent, m; share : the smaller pad's share of contact points in the grasping area; free : the opened
+    gripper's swept fingers and palm clear of the cloud and of a blocking support."""
+
+    spans: np.ndarray
+    section: np.ndarray
+    share: np.ndarray
+    free: np.ndarray
+
+    @classmethod
+    def empty(cls, k: int, m: int) -> "PathTests":
+        return cls(
+            np.full((k, m, 2), np.nan),
+            np.full((k, m), np.nan),
+            np.full((k, m), np.nan),
+            np.ones((k, m), bool),
+        )
+
+
+def _choose_path(
+    req: PlanRequest, cand: Candidates, openings: np.ndarray, tests: PathTests
+) -> tuple[tuple[int, int], np.ndarray, float]:
+    """Step 7: the cheapest path passing the section test (``planner.section_fit``), the swept check
+    (``planner.swept_check``) and the area rule (``planner.min_contacts_in_area``), examined lazily in
+    cost order; with none of them, the least cost. Fills ``tests`` for the paths examined, in place.
+    Returns the (cluster, path) chosen, its (3, 3) rotation and the in-area share required.
     """
-    points, centers, directions, costs = cand.points, cand.clusters.centers_m, cand.directions, cand.costs
+    pl, gr = req.planner, req.gripper
+    directions, costs = cand.directions, cand.costs
     k, m = costs.shape
+    need = float(pl.min_contacts_in_area)
     order = np.argsort(costs, axis=None, kind="stable")[: int(cand.feasible.sum())]
     start, n_batches = 0, 0
     while start < len(order):
@@ -266,20 +298,78 @@ def _cheapest_fitting(
         start, n_batches = start + len(batch), n_batches + 1
         ks, ps = np.unravel_index(batch, (k, m))
         rots = grasp_rotations(directions[ks, ps], cand.pose_axis)
-        spans[ks, ps] = slab_spans_m(points, centers[ks], rots, gr)
-        extent = spans[ks, ps, 1] - spans[ks, ps, 0]
-        section[ks, ps] = extent
-        fit = np.flatnonzero(extent <= openings[ks])
+        ok = _test_batch(req, cand, openings, tests, ks, ps, rots)
+        ok &= tests.share[ks, ps] >= need if need > 0 else True
+        fit = np.flatnonzero(ok)
         if len(fit):
-            return (int(ks[fit[0]]), int(ps[fit[0]])), rots[fit[0]], False
-    # Fallback: no section fits its r_k opening; every path above the support was examined. Keep those
-    # whose section fits the stroke and open to the section plus margin.
-    fits = cand.feasible & (section <= gr.max_width_m)
-    if not fits.any():
+            return (int(ks[fit[0]]), int(ps[fit[0]])), rots[fit[0]], need
+    # Every path above the support was examined and none passed. Fallbacks: a section that fits the
+    # stroke (opened to the section), then, in pl.fallback_modes, the largest in-area share reached.
+    section, share = tests.section, tests.share
+    stroke_ok = cand.feasible & (section <= gr.max_width_m) if pl.section_fit else cand.feasible
+    if pl.section_fit and not stroke_ok.any():
         raise NoFeasibleGrasp(
             f"object wider than the gripper: on all {len(order)} paths above the support the object's "
             f"section between the pads exceeds gripper.max_width_m = {gr.max_width_m} m"
         )
-    flat = int(np.argmin(np.where(fits, costs, np.inf)))
+    stroke_ok &= tests.free
+    if not stroke_ok.any():
+        raise NoFeasibleGrasp(
+            f"{pl.name}: on all {len(order)} paths above the support whose section fits the stroke the "
+            "opened gripper's swept fingers or palm meet the object or the support (planner.swept_check)"
+        )
+    if need > 0 and not (stroke_ok & (share >= need)).any():
+        best_share = float(np.max(share[stroke_ok]))
+        fallback = fallback_share(req, best_share)
+        if fallback is None:
+            raise NoFeasibleGrasp(
+                f"{pl.name}: every one of the {len(order)} paths above the support whose section fits the "
+                "stroke and whose swept gripper is clear has " + no_grasp_in_area(req, best_share)
+            )
+        need = fallback
+    ok = stroke_ok & (share >= need) if need > 0 else stroke_ok
+    fits = ok & (section <= openings[:, None]) if pl.section_fit else ok
+    flat = int(np.argmin(np.where(fits if fits.any() else ok, costs, np.inf)))
     best = (flat // m, flat % m)
-    return best, grasp_rotation(directions[best], cand.pose_axis), True
+    return best, grasp_rotation(directions[best], cand.pose_axis), need
+
+
+def _test_batch(
+    req: PlanRequest,
+    cand: Candidates,
+    openings: np.ndarray,
+    tests: PathTests,
+    ks: np.ndarray,
+    ps: np.ndarray,
+    rots: np.ndarray,
+) -> np.ndarray:
+    """Run step 7's tests on the (B,) paths ``(ks, ps)`` with (B, 3, 3) rotations ``rots``, filling
+    ``tests``; returns (B,) whether each passes the section test and the swept check (the area rule's
+    share is left in ``tests.share``)."""
+    pl, gr = req.planner, req.gripper
+    points, centers = cand.points, cand.clusters.centers_m
+    spans = slab_spans_m(points, centers[ks], rots, gr)
+    extent = spans[:, 1] - spans[:, 0]
+    tests.spans[ks, ps], tests.section[ks, ps] = spans, extent
+    ok = extent <= openings[ks] if pl.section_fit else np.ones(len(ks), dtype=bool)
+    poses = np.tile(np.eye(4), (len(ks), 1, 1))
+    poses[:, :3, :3], poses[:, :3, 3] = rots, centers[ks]
+    if pl.min_contacts_in_area > 0:  # contacts do not depend on the shift along the closing axis
+        normals = np.asarray(req.normals, dtype=np.float64)
+        geometry = GripperGeometry.of(gr)
+        tests.share[ks, ps] = pad_contacts(
+            points, normals, poses, geometry, pl.contact_band_m, cand.area_mask
+        )[2]
+    if pl.swept_check:
+        if pl.grasp_point == "section_middle":
+            poses[:, :3, 3] += spans.mean(axis=1)[:, None] * rots[:, :, 1]
+        widths = openings[ks]
+        if pl.section_fit:  # a path too wide for its opening is opened to its section (fallback)
+            widened = np.clip(extent * (1.0 + pl.width_margin), gr.min_width_m, gr.max_width_m)
+            widths = np.where(extent <= openings[ks], widths, widened)
+        free = cloud_hits(points, poses, gr, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0) == 0
+        if req.support_blocks_gripper:
+            free &= lowest_z(poses, gr, widths, pl.sphere_radius_m) >= req.table_z
+        tests.free[ks, ps] = free
+        ok &= free
+    return ok

@@ -58,7 +58,7 @@ OPENING_CONSTRAINTS = {**COLLISION_CONSTRAINTS, "width_clearance_m": [Interval(0
 
 
 @dataclass
-class AreaContactConfig(OpeningConfig):
+class AreaRuleConfig(PlannerConfig):
     """Planners that check where their pads touch: each pad's contact points (the cloud points within
     ``contact_band_m`` of the section's extreme between the pads) must be grasping-area points
     (:func:`graspexp.planning.stability.pad_contacts`, :mod:`graspexp.planning.area_rule`)."""
@@ -84,10 +84,20 @@ class AreaContactConfig(OpeningConfig):
     spacing (2048 points on a Table 1 object)."""
 
 
-AREA_CONTACT_CONSTRAINTS = {
-    **OPENING_CONSTRAINTS,
+AREA_RULE_CONSTRAINTS = {
+    **BASE_CONSTRAINTS,
     "min_contacts_in_area": [Interval(0, 1)],
     "fallback_contacts_in_area": [Interval(0, 1)],
     "fallback_modes": [Vector(None, Options(("collab", "bin")))],
     "contact_band_m": [Interval(0, 0.05, "right", "m")],
 }
+"""Allowed values of the keys of :class:`AreaRuleConfig`."""
+
+
+@dataclass
+class AreaContactConfig(AreaRuleConfig, OpeningConfig):
+    """Planners that open to the section, check collisions and apply the area rule of
+    :class:`AreaRuleConfig` (antipodal, optimal_plus)."""
+
+
+AREA_CONTACT_CONSTRAINTS = {**OPENING_CONSTRAINTS, **AREA_RULE_CONSTRAINTS}
