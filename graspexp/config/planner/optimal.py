@@ -100,8 +100,8 @@ class OptimalConfig(PaperPathsConfig, AreaRuleConfig):
     (module doc, step 7). III-A: "the robot arm firstly needs to detect a proper contact area of the
     object", and the area is where the robot may grasp (a person holds the rest, IV-C). The paper aims
     its paths at the area's cluster centres and does not test where the 8 cm fingers land, so 0 = as
-    printed: without the test 27 % (YCB) and 24 % (LINEMOD) of this reading's finger contacts lay
-    outside the area at the end of closing (the in-area metric, 360 trials each; README)."""
+    printed: without it (and the swept check) 23 % (YCB) and 18 % (LINEMOD) of this reading's finger
+    contacts lay outside the area at the end of closing (the in-area metric, 360 trials each; README)."""
     fallback_contacts_in_area: float = 1.0
     """No fallback (see :class:`AreaRuleConfig`): the paper plans from its grasping area's clusters in
     every mode and never grasps elsewhere; bin picking is one more application with a chosen area
