@@ -181,8 +181,7 @@ def test_the_swept_check_keeps_the_palm_out_of_the_object() -> None:
     for seed in range(8):
         for name, (planner, *extra) in PAPER_SWEEP_VARIANTS.items():
             g = _plan_with(planner, pts, normals, area, seed, *extra)
-            found = hits[name]
-            found.append(cloud_hits(pts, g.pose[None], RG2, g.width_m, sweep_m=0.1, margin_m=0.0)[0])
+            hits[name].append(cloud_hits(pts, g.pose[None], RG2, g.width_m, sweep_m=0.1, margin_m=0.0)[0])
     assert sum(h > 0 for h in hits["no_checks"]) >= 3
     assert not any(h for name in CHECKED for h in hits[name])
 

@@ -52,7 +52,7 @@ import numpy as np
 
 from graspexp.config.gripper import GripperGeometry
 from graspexp.geometry import make_pose
-from graspexp.planning.area_rule import fallback_share, no_grasp_in_area
+from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
 from graspexp.planning.clusters import Clusters, choose_k, main_axis, max_radii_m, segment
 from graspexp.planning.collision import cloud_hits, lowest_z
 from graspexp.planning.cost import all_path_costs
@@ -206,11 +206,9 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
     kb, pb = best
     slab_extent = float(section[kb, pb])
     pose = make_pose(best_rotation, centers[kb])
-    shift_m = float(spans[kb, pb].mean()) if pl.grasp_point == "section_middle" else 0.0
+    shift_m = float(_centre_shifts_m(pl, spans[kb, pb][None])[0])
     pose[:3, 3] += shift_m * pose[:3, 1]  # pads close symmetrically about the origin (pose.py doc)
-    width = float(openings[kb])
-    if widened:
-        width = float(np.clip(slab_extent * (1.0 + pl.width_margin), gr.min_width_m, gr.max_width_m))
+    width = float(_opened_widths_m(pl, gr, section[kb, pb][None], openings[kb][None])[0])
     grasp = Grasp(
         pose=pose,
         width_m=width,
@@ -298,36 +296,36 @@ def _choose_path(
         start, n_batches = start + len(batch), n_batches + 1
         ks, ps = np.unravel_index(batch, (k, m))
         rots = grasp_rotations(directions[ks, ps], cand.pose_axis)
-        ok = _test_batch(req, cand, openings, tests, ks, ps, rots)
-        ok &= tests.share[ks, ps] >= need if need > 0 else True
-        fit = np.flatnonzero(ok)
+        fit = np.flatnonzero(_test_batch(req, cand, openings, tests, ks, ps, rots))
         if len(fit):
             return (int(ks[fit[0]]), int(ps[fit[0]])), rots[fit[0]], need
     # Every path above the support was examined and none passed. Fallbacks: a section that fits the
     # stroke (opened to the section), then, in pl.fallback_modes, the largest in-area share reached.
     section, share = tests.section, tests.share
-    stroke_ok = cand.feasible & (section <= gr.max_width_m) if pl.section_fit else cand.feasible
-    if pl.section_fit and not stroke_ok.any():
+    fits_stroke = cand.feasible & ((section <= gr.max_width_m) | (not pl.section_fit))
+    if not fits_stroke.any():
         raise NoFeasibleGrasp(
             f"object wider than the gripper: on all {len(order)} paths above the support the object's "
             f"section between the pads exceeds gripper.max_width_m = {gr.max_width_m} m"
         )
-    stroke_ok &= tests.free
-    if not stroke_ok.any():
+    clear = fits_stroke & tests.free
+    if not clear.any():
         raise NoFeasibleGrasp(
             f"{pl.name}: on all {len(order)} paths above the support whose section fits the stroke the "
             "opened gripper's swept fingers or palm meet the object or the support (planner.swept_check)"
         )
-    if need > 0 and not (stroke_ok & (share >= need)).any():
-        best_share = float(np.max(share[stroke_ok]))
-        fallback = fallback_share(req, best_share)
-        if fallback is None:
-            raise NoFeasibleGrasp(
-                f"{pl.name}: every one of the {len(order)} paths above the support whose section fits the "
-                "stroke and whose swept gripper is clear has " + no_grasp_in_area(req, best_share)
-            )
-        need = fallback
-    ok = stroke_ok & (share >= need) if need > 0 else stroke_ok
+    ok = clear
+    if need > 0:
+        ok, _, best_share = area_test(clear, share, need)
+        if not ok.any():
+            fallback = fallback_share(req, best_share)
+            if fallback is None:
+                raise NoFeasibleGrasp(
+                    f"{pl.name}: every one of the {len(order)} paths above the support whose section fits "
+                    "the stroke and whose swept gripper is clear has " + no_grasp_in_area(req, best_share)
+                )
+            need = fallback
+            ok = area_test(clear, share, need)[0]
     fits = ok & (section <= openings[:, None]) if pl.section_fit else ok
     flat = int(np.argmin(np.where(fits if fits.any() else ok, costs, np.inf)))
     best = (flat // m, flat % m)
@@ -344,8 +342,7 @@ def _test_batch(
     rots: np.ndarray,
 ) -> np.ndarray:
     """Run step 7's tests on the (B,) paths ``(ks, ps)`` with (B, 3, 3) rotations ``rots``, filling
-    ``tests``; returns (B,) whether each passes the section test and the swept check (the area rule's
-    share is left in ``tests.share``)."""
+    ``tests``; returns (B,) whether each passes every test switched on."""
     pl, gr = req.planner, req.gripper
     points, centers = cand.points, cand.clusters.centers_m
     spans = slab_spans_m(points, centers[ks], rots, gr)
@@ -357,19 +354,30 @@ def _test_batch(
     if pl.min_contacts_in_area > 0:  # contacts do not depend on the shift along the closing axis
         normals = np.asarray(req.normals, dtype=np.float64)
         geometry = GripperGeometry.of(gr)
-        tests.share[ks, ps] = pad_contacts(
-            points, normals, poses, geometry, pl.contact_band_m, cand.area_mask
-        )[2]
+        share = pad_contacts(points, normals, poses, geometry, pl.contact_band_m, cand.area_mask)[2]
+        tests.share[ks, ps] = share
+        ok &= share >= pl.min_contacts_in_area
     if pl.swept_check:
-        if pl.grasp_point == "section_middle":
-            poses[:, :3, 3] += spans.mean(axis=1)[:, None] * rots[:, :, 1]
-        widths = openings[ks]
-        if pl.section_fit:  # a path too wide for its opening is opened to its section (fallback)
-            widened = np.clip(extent * (1.0 + pl.width_margin), gr.min_width_m, gr.max_width_m)
-            widths = np.where(extent <= openings[ks], widths, widened)
+        poses[:, :3, 3] += _centre_shifts_m(pl, spans)[:, None] * rots[:, :, 1]
+        widths = _opened_widths_m(pl, gr, extent, openings[ks])
         free = cloud_hits(points, poses, gr, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0) == 0
         if req.support_blocks_gripper:
             free &= lowest_z(poses, gr, widths, pl.sphere_radius_m) >= req.table_z
         tests.free[ks, ps] = free
         ok &= free
     return ok
+
+
+def _centre_shifts_m(pl, spans: np.ndarray) -> np.ndarray:
+    """(B,) move of the grasp point from c_k along the closing axis Y, m, for (B, 2) section spans: to the
+    section's middle (``planner.grasp_point: section_middle``) or none (``centre``)."""
+    return spans.mean(axis=1) if pl.grasp_point == "section_middle" else np.zeros(len(spans))
+
+
+def _opened_widths_m(pl, gr, extent_m: np.ndarray, openings_m: np.ndarray) -> np.ndarray:
+    """(B,) opening of paths with (B,) section extents and (B,) cluster openings w_k, m: w_k, or with
+    ``planner.section_fit`` a section wider than w_k opened to ``clip(section (1 + width_margin))``."""
+    if not pl.section_fit:
+        return openings_m
+    widened = np.clip(extent_m * (1.0 + pl.width_margin), gr.min_width_m, gr.max_width_m)
+    return np.where(extent_m <= openings_m, openings_m, widened)

@@ -7,7 +7,8 @@ grasping-area point of the object's reference cloud (:data:`AREA_REFERENCE_POINT
 run's cloud seed, the dataset's area rules) lies within :data:`IN_AREA_TOLERANCE_M` of it. The reference
 is the same for every planner. (The planner's own cloud, the reference until December 2026, leaves random
 gaps between area points of up to 9-13 mm with 2048 points and 5-9.5 mm with 4096 on the larger objects,
-so contacts on an area face were counted outside, more often for the planners with the sparser cloud.) Trials whose fingers do not touch the object then have no contacts to count.
+so contacts on an area face were counted outside, more often for the planners with the sparser cloud.)
+Trials whose fingers do not touch the object then have no contacts to count.
 """
 
 from __future__ import annotations
