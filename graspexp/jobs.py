@@ -16,6 +16,7 @@ import hashlib
 import os
 import sys
 import tempfile
+import time
 import uuid
 from pathlib import Path
 from typing import Any
@@ -121,8 +122,11 @@ class SweepReport(Callback):
     def on_multirun_start(self, config: DictConfig, **kwargs: Any) -> None:
         self._check_output(config.hydra.sweep.dir)
         os.environ[SWEEP_ID_ENV] = uuid.uuid4().hex
+        self._started = time.perf_counter()
 
     def on_multirun_end(self, config: DictConfig, **kwargs: Any) -> None:
+        wall = time.perf_counter() - getattr(self, "_started", time.perf_counter())
+        print(f"\ngraspexp: sweep {config.hydra.sweep.dir} done in {wall:.1f} s wall", file=sys.stderr)
         folder = Path(config.hydra.sweep.dir) / FAILED_DIR / os.environ.get(SWEEP_ID_ENV, "unknown")
         records = sorted(folder.glob("*.txt")) if folder.is_dir() else []
         lines = [r.read_text().strip() for r in records]

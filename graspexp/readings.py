@@ -33,7 +33,16 @@ class Reading:
 
 
 READINGS: tuple[Reading, ...] = (
-    Reading("default", ("planner=optimal",), "this project's reading (conf/planner/optimal.yaml)"),
+    Reading(
+        "default",
+        ("planner=optimal",),
+        "the paper's method as this project reads it (conf/planner/optimal.yaml)",
+    ),
+    Reading(
+        "in_area",
+        ("planner=optimal_in_area",),
+        "optimal_in_area: every pad contact in the grasping area, object axis (the default until Dec 2026)",
+    ),
     Reading(
         "literal", ("planner=optimal_literal",), "the paper as printed (conf/planner/optimal_literal.yaml)"
     ),
@@ -56,18 +65,25 @@ READINGS: tuple[Reading, ...] = (
         "no swept check: fingers and palm may meet the object or the table",
     ),
     Reading(
-        "no_area_rule",
-        ("planner=optimal", "planner.min_contacts_in_area=0"),
-        "no area rule: the pads may land outside the grasping area",
+        "area_rule",
+        ("planner=optimal", "planner.min_contacts_in_area=1"),
+        "area rule: every pad contact point in the grasping area (not in the paper)",
     ),
     Reading(
         "bin_fallback",
-        ("planner=optimal", "planner.fallback_contacts_in_area=0"),
-        "bin: the grasp touching the area most when none is inside it",
+        ("planner=optimal", "planner.min_contacts_in_area=1", "planner.fallback_contacts_in_area=0"),
+        "area rule, and in bin the grasp touching the area most when none is inside it",
     ),
     Reading("no_margin", ("planner=optimal", "planner.width_margin=0"), "opening = 2 r_k exactly"),
     Reading(
-        "pose_axis_area", ("planner=optimal", "planner.pose_axis=area"), "grasp X = the area's main axis"
+        "pose_axis_object",
+        ("planner=optimal", "planner.pose_axis=object"),
+        "grasp X = the object's main axis, every object",
+    ),
+    Reading(
+        "pose_axis_area",
+        ("planner=optimal", "planner.pose_axis=area"),
+        "grasp X = the area's main axis, every object (as printed)",
     ),
     Reading(
         "alpha_axis_area", ("planner=optimal", "planner.main_axis=area"), "alpha and K from the area's axis"

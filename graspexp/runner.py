@@ -20,6 +20,7 @@ import os
 import platform
 import socket
 import sys
+import time
 import traceback
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -324,6 +325,7 @@ def run_in_dir(cfg: DictConfig, run_dir: Path) -> float:
 
 
 def _run(cfg: DictConfig, run_dir: Path) -> float:
+    wall0, cpu0 = time.perf_counter(), time.process_time()
     objects = select_objects(cfg.dataset, cfg.objects)
     check_resumable(cfg, run_dir)
     prepare_shapes(cfg.dataset, cfg.sim, objects, cfg.progress)
@@ -343,6 +345,7 @@ def _run(cfg: DictConfig, run_dir: Path) -> float:
     (run_dir / "summary.md").write_text(text + "\n")
     print(
         f"\n{cfg.mode.name} / rot {cfg.rot.name} / {cfg.dataset.name} / planner {cfg.planner.name}: {run_dir}"
+        f" ({len(df)} trials, {time.perf_counter() - wall0:.1f} s wall, {time.process_time() - cpu0:.1f} s CPU)"
     )
     print(text)
     return float(df["success"].mean())

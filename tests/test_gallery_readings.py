@@ -113,7 +113,7 @@ def test_a_reading_directory_with_two_configs_is_refused(readings_dir: Path, tmp
 
 
 def test_readings_command_shape_and_bad_names(tmp_path: Path, capsys) -> None:
-    assert [r.name for r in READINGS[:2]] == ["default", "literal"]
+    assert [r.name for r in READINGS[:3]] == ["default", "in_area", "literal"]
     cmd = sweep_command(ALL["r_rms"], tmp_path, "ycb,linemod", 10)
     assert cmd[-2:] == ["planner=optimal", "planner.cluster_radius=rms"]
     assert "mode=collab,bin" in cmd and "rot=z,xyz" in cmd and f"hydra.sweep.dir={tmp_path / 'r_rms'}" in cmd

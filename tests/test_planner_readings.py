@@ -8,7 +8,7 @@ from test_planner_common import PAPER_STEPS_ONLY, RG2, cylinder_cloud, request
 
 from graspexp.config import OptimalConfig
 from graspexp.planning import plan_optimal
-from graspexp.planning.clusters import main_axis
+from graspexp.planning.clusters import elongation, main_axis
 
 
 def _can_with_band(seed: int = 3):
@@ -78,15 +78,7 @@ def test_pose_axis_sets_the_grasp_x_axis_and_main_axis_the_cost_angle():
 def test_presets_differ_only_in_the_documented_reading_keys():
     ours, literal = compose_cfg("planner=optimal").planner, compose_cfg("planner=optimal_literal").planner
     differ = {k for k in ours if ours[k] != literal[k]}
-    assert differ == {
-        "name",
-        "pose_axis",
-        "grasp_point",
-        "section_fit",
-        "width_margin",
-        "swept_check",
-        "min_contacts_in_area",
-    }
+    assert differ == {"name", "pose_axis", "grasp_point", "section_fit", "width_margin", "swept_check"}
     assert (literal.pose_axis, literal.grasp_point, literal.section_fit, literal.width_margin) == (
         "area",
         "centre",
@@ -94,6 +86,54 @@ def test_presets_differ_only_in_the_documented_reading_keys():
         0.0,
     )
     assert (literal.swept_check, literal.min_contacts_in_area) == (False, 0.0)
+
+
+def test_the_paper_preset_has_no_area_rule_and_optimal_in_area_adds_only_that_and_the_object_axis():
+    """``optimal`` rejects no path for where its pads land (the paper scores "still held", IV-C);
+    ``optimal_in_area`` is the earlier default: the area rule on the pads and the object's axis as X."""
+    ours, in_area = compose_cfg("planner=optimal").planner, compose_cfg("planner=optimal_in_area").planner
+    assert ours.min_contacts_in_area == 0.0 and ours.pose_axis == "area_if_elongated"
+    differ = {k for k in ours if ours[k] != in_area[k]}
+    assert differ == {"name", "min_contacts_in_area", "pose_axis"}
+    assert (in_area.min_contacts_in_area, in_area.pose_axis) == (1.0, "object")
+
+
+def _l_shape(seed: int = 5):
+    """An L of two 20 mm bars on a table at z = 0.1: a 160 mm housing along X (the grasping area) and a
+    120 mm handle along -Y below one end; the whole L's main axis lies between them."""
+    rng = np.random.default_rng(seed)
+    housing = rng.uniform([-0.08, -0.01, 0.1], [0.08, 0.01, 0.12], (1500, 3))
+    handle = rng.uniform([-0.08, -0.13, 0.1], [-0.06, -0.01, 0.12], (1500, 3))
+    pts = np.vstack([housing, handle])
+    return pts, np.arange(len(pts)) < len(housing)
+
+
+def test_area_if_elongated_takes_the_area_axis_of_a_long_area_and_the_object_axis_of_a_ring():
+    # A long area (elongation ~8): the area's axis, unlike the L's own.
+    pts, mask = _l_shape()
+    assert elongation(pts[mask]) > 4
+    pl = OptimalConfig(
+        name="optimal", pose_axis="area_if_elongated", min_contacts_in_area=0.0, swept_check=False
+    )
+    res = plan_optimal(request(pts, mask, table_z=0.1, planner=pl))
+    np.testing.assert_array_equal(res.details["pose_axis"], main_axis(pts[mask]))
+    assert abs(main_axis(pts) @ main_axis(pts[mask])) < 0.95
+    # A band around a can (elongation ~1: any direction across it is a first component): the object's.
+    can, band = _can_with_band()
+    assert elongation(can[band]) < 1.5
+    res = plan_optimal(request(can, band, table_z=0.1, planner=pl))
+    np.testing.assert_array_equal(res.details["pose_axis"], main_axis(can))
+    # The threshold decides: above the area's elongation, the object's axis is used there too.
+    high = OptimalConfig(**{**pl.__dict__, "pose_axis_min_elongation": elongation(pts[mask]) + 1})
+    res = plan_optimal(request(pts, mask, table_z=0.1, planner=high))
+    np.testing.assert_array_equal(res.details["pose_axis"], main_axis(pts))
+
+
+def test_elongation_is_the_ratio_of_the_principal_standard_deviations():
+    rng = np.random.default_rng(0)
+    box = rng.uniform(-1, 1, (20_000, 3)) * [3.0, 1.0, 0.5]
+    assert elongation(box) == pytest.approx(3.0, rel=0.03)
+    assert elongation(np.zeros((1, 3))) == 1.0
 
 
 def test_literal_preset_plans_the_printed_argmin_at_c_k():

@@ -11,6 +11,7 @@ from graspexp.outcome import FailureReason, TrialResult
 from graspexp.record import TrialRecorder
 from graspexp.report import build_report, collect, wilson_interval, write_report
 from graspexp.report.__main__ import main as report_main
+from graspexp.report.agreement import p_below
 from graspexp.report.paper import BASELINES, SETTINGS, TABLE1, TABLE2
 from graspexp.report.render import display_frame, latex_escape
 from tests.conftest import compose_cfg
@@ -202,6 +203,16 @@ def test_report_cli_writes_markdown_csv_latex_png(sweep_dir: Path, tmp_path: Pat
     for stem in ("failures", "runtime"):
         for ext in ("md", "csv", "tex"):
             assert (out / f"{stem}.{ext}").is_file()
+    for stem in ("agreement_ycb_optimal", "agreement_linemod_optimal"):
+        for ext in ("md", "csv", "png"):
+            assert (out / f"{stem}.{ext}").stat().st_size > 0
+    assert "## Agreement with the paper: ycb, planner optimal" in printed
+    assert "Z-Collab in area" in printed and "held, contacts in area %" in printed
+    flagged = pd.read_csv(out / "agreement_ycb_optimal.csv").query("flagged")
+    assert list(flagged["label"]) == ["Cleanser B.", "All objects (pooled)"]
+    assert (
+        out / "agreement"
+    ).is_dir() and "agreement/ycb_optimal_collab_xyz_021_bleach_cleanser_000.png" in printed
     assert (out / "report.md").read_text() in printed
     csv = pd.read_csv(out / "table1_ycb_optimal.csv", index_col="label")
     assert csv.loc["Cleanser B.", "collab_z_ours_pct"] == 90.0
@@ -253,3 +264,57 @@ def test_duplicate_trials_are_counted_once_and_named(sweep_dir: Path, tmp_path: 
     assert len(col.results) == 10 and len(col.duplicates) == 10
     text = write_report(build_report(root), tmp_path / "out")
     assert "## Duplicate trials (10)" in text
+
+
+# ---------------------------------------------------------------- agreement with the paper
+
+
+@pytest.mark.parametrize(
+    ("ours", "paper", "p"),
+    [
+        ((0, 10), (10, 10), 1 / 184756),  # 1 / C(20, 10)
+        ((6, 10), (10, 10), 210 / 4845),  # C(10, 6) / C(20, 16)
+        ((7, 10), (10, 10), 120 / 1140),
+        ((10, 10), (10, 10), 1.0),
+        ((10, 30), (10, 10), None),  # checked against scipy below
+    ],
+)
+def test_fisher_one_sided_p_below_the_paper(ours, paper, p) -> None:
+    from scipy.stats import fisher_exact
+
+    got = p_below(*ours, *paper)
+    expected = p if p is not None else fisher_exact([[10, 20], [10, 0]], alternative="less").pvalue
+    assert got == pytest.approx(expected, rel=1e-9)
+    assert p_below(0, 0, 5) == 1.0
+
+
+def test_agreement_flags_cells_below_the_paper_with_their_failure_reason(sweep_dir: Path) -> None:
+    report = build_report(sweep_dir, progress=False)
+    ag = {a.dataset: a for a in report.agreements}
+    assert set(ag) == {"ycb", "linemod"}
+    cells = ag["ycb"].objects.set_index(["label", "mode", "rot"])
+    bleach_z = cells.loc[("Cleanser B.", "collab", "z")]
+    assert (bleach_z["ours_k"], bleach_z["ours_n"], bleach_z["paper_k"]) == (9, 10, 10)
+    assert bleach_z["p_below"] == pytest.approx(0.5) and not bleach_z["flagged"]
+    bleach_xyz = cells.loc[("Cleanser B.", "collab", "xyz")]  # 0/10 against the paper's 9/10
+    assert bleach_xyz["flagged"] and bleach_xyz["top_reason"] == "dropped"
+    assert bleach_xyz["p_below"] == pytest.approx(p_below(0, 10, 9))
+    ape = ag["linemod"].objects.set_index("label").loc["Ape"]  # 5/10 against 9/10: p = 0.07
+    assert ape["p_below"] == pytest.approx(p_below(5, 10, 9)) and not ape["flagged"]
+    # One pooled row per setting: every trial of the paper objects we ran against their printed rates.
+    pooled = ag["ycb"].cells[ag["ycb"].cells["object"] == ""].set_index(["mode", "rot"])
+    assert (pooled.loc[("collab", "z"), "ours_k"], pooled.loc[("collab", "z"), "ours_n"]) == (19, 20)
+    assert (pooled.loc[("collab", "z"), "paper_k"], pooled.loc[("collab", "z"), "paper_n"]) == (20, 20)
+    summary = ag["ycb"].summary()
+    assert summary.startswith("ycb / optimal: 1 of 3 object cells significantly below the paper")
+    assert "settings significantly below: XYZ Collaborative" in summary
+
+
+def test_in_area_criterion_is_na_where_it_cannot_be_told_and_zero_without_contacts(sweep_dir: Path) -> None:
+    """The hand-made logs hold no contacts: a held trial without contacts is not held in the area."""
+    report = build_report(sweep_dir, progress=False)
+    mug = _cell(report.tables[0], "Mug", "collab", "z")
+    assert mug["ours_pct"] == 100.0 and mug["in_area_pct"] == 0.0
+    assert set(report.strict["in_area_pct"]) == {0.0}
+    disp = display_frame(report.tables[0])
+    assert disp.loc["Mug", "Z-Collab in area"] == "0"

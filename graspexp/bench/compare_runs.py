@@ -1,6 +1,9 @@
-"""Check that two sweeps gave the same trials: ``python -m graspexp.bench.compare_runs BEFORE AFTER``.
+"""Check that two sweeps gave the same trials: ``python -m graspexp.bench.compare_runs BEFORE AFTER
+[--planner OLD=NEW]``.
 
-Every ``results.csv`` under BEFORE is matched with the file at the same relative path under AFTER, and
+Every ``results.csv`` under BEFORE is matched with the file at the same relative path under AFTER (with
+``--planner OLD=NEW``: a preset renamed between the runs, ``planner=OLD`` in the path and ``OLD`` in the
+``planner`` column stand for ``NEW``), and
 every row (keyed by object and trial) is compared cell by cell as text, so a float that changed in its last
 digit counts. Wall-clock timing columns (``timings_s*``) are ignored. Exit status 0 when every row is
 identical, 1 otherwise (the differing cells are printed).
@@ -27,17 +30,25 @@ def _rows(path: Path) -> dict[tuple[str, str], dict[str, str]]:
         }
 
 
-def compare(before: Path, after: Path) -> list[str]:
-    """Differences between the sweeps under ``before`` and ``after``, one line each; [] when identical."""
+def compare(before: Path, after: Path, rename: tuple[str, str] | None = None) -> list[str]:
+    """Differences between the sweeps under ``before`` and ``after``, one line each; [] when identical.
+    ``rename``: (old, new) planner name (module doc)."""
     problems = []
     tables = sorted(p.relative_to(before) for p in before.rglob("results.csv"))
     if not tables:
         return [f"no results.csv under {before}"]
     for rel in tables:
-        if not (after / rel).is_file():
-            problems.append(f"{rel}: missing under {after}")
+        rel_after = (
+            Path(str(rel).replace(f"planner={rename[0]},", f"planner={rename[1]},")) if rename else rel
+        )
+        if not (after / rel_after).is_file():
+            problems.append(f"{rel_after}: missing under {after}")
             continue
-        a, b = _rows(before / rel), _rows(after / rel)
+        a, b = _rows(before / rel), _rows(after / rel_after)
+        if rename:
+            for row in a.values():
+                if row.get("planner") == rename[0]:
+                    row["planner"] = rename[1]
         for key in sorted(a.keys() | b.keys()):
             if key not in a or key not in b:
                 problems.append(f"{rel} {key}: only under {before if key in a else after}")
@@ -52,8 +63,17 @@ def main(argv: list[str] | None = None) -> int:
     parser = tool_parser("graspexp.bench.compare_runs", __doc__.splitlines()[0])
     parser.add_argument("before", type=Path, help="sweep directory of the reference run")
     parser.add_argument("after", type=Path, help="sweep directory of the run to check")
+    parser.add_argument(
+        "--planner", metavar="OLD=NEW", default=None, help="a planner preset renamed between the two runs"
+    )
     args = parser.parse_args(argv)
-    problems = compare(args.before, args.after)
+    rename = None
+    if args.planner:
+        old, sep, new = args.planner.partition("=")
+        if not sep or not old or not new:
+            parser.error(f"--planner {args.planner!r}: expected OLD=NEW, e.g. optimal=optimal_in_area")
+        rename = (old, new)
+    problems = compare(args.before, args.after, rename)
     n_tables = len(list(args.before.rglob("results.csv")))
     n_rows = sum(len(_rows(p)) for p in args.before.rglob("results.csv"))
     for line in problems:

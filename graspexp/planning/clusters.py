@@ -11,6 +11,10 @@ K (``planner.k: auto``)
     planner.auto_k_stroke_fraction`` (its docstring gives the reading); a bigger gripper gives fewer
     clusters, as the paper asks (III-B, IV-D). K never exceeds the number of area points.
 
+Pose axis (``planner.pose_axis``)
+    ``object`` / ``area``: the main axis of that cloud; ``area_if_elongated``: the area's main axis when
+    the area's :func:`elongation` is at least ``planner.pose_axis_min_elongation``, else the object's.
+
 Radius ``r_k`` (``planner.cluster_radius``)
     ``rms``: the root-mean-square distance of the cluster's points from its centre ``c_k`` (the centre
     is the cluster mean, so ``r_k^2`` is the cluster's total variance); ``max``: the largest distance
@@ -49,6 +53,18 @@ def main_axis(points_m: np.ndarray) -> np.ndarray:
     if axis[int(np.argmax(np.abs(axis)))] < 0:
         axis = -axis
     return axis
+
+
+def elongation(points_m: np.ndarray) -> float:
+    """Ratio of the first to the second principal standard deviation of (n, 3) points, sqrt(l1 / l2)
+    (dimensionless, >= 1): how clearly the cloud has a main axis. 1 for a ring or a disc, where the first
+    principal component is any direction in its plane; inf when l2 = 0 (collinear points)."""
+    pts = np.asarray(points_m, dtype=np.float64)
+    if len(pts) < 2:
+        return 1.0
+    centred = pts - pts.mean(axis=0)
+    vals = np.linalg.eigvalsh(centred.T @ centred / len(pts))  # ascending
+    return math.inf if vals[1] <= 0 else float(math.sqrt(max(vals[2], 0.0) / vals[1]))
 
 
 def extent_along(points_m: np.ndarray, axis: np.ndarray) -> float:

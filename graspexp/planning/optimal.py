@@ -53,7 +53,7 @@ import numpy as np
 from graspexp.config.gripper import GripperGeometry
 from graspexp.geometry import make_pose
 from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
-from graspexp.planning.clusters import Clusters, choose_k, main_axis, max_radii_m, segment
+from graspexp.planning.clusters import Clusters, choose_k, elongation, main_axis, max_radii_m, segment
 from graspexp.planning.collision import cloud_hits, lowest_z
 from graspexp.planning.cost import all_path_costs
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
@@ -118,8 +118,9 @@ def paper_candidates(req: PlanRequest, planner: str, cluster_length_m: float | N
         raise NoFeasibleGrasp(f"{planner}: the grasping area is empty: no point of the cloud is in area_mask")
 
     pl, gr = req.planner, req.gripper
-    axes = {name: main_axis(points if name == "object" else area) for name in {pl.main_axis, pl.pose_axis}}
-    axis = axes[pl.main_axis]
+    source = pose_axis_source(pl, area)
+    axes = {name: main_axis(points if name == "object" else area) for name in {pl.main_axis, source}}
+    axis, pose_axis = axes[pl.main_axis], axes[source]
     if cluster_length_m is None:
         k = choose_k(pl.k, pl.k_max, area, axis, gr.max_width_m, pl.auto_k_stroke_fraction)
     else:
@@ -140,7 +141,16 @@ def paper_candidates(req: PlanRequest, planner: str, cluster_length_m: float | N
             f"{req.table_z + pl.table_clearance_m:.4f} m (sphere radius {pl.sphere_radius_m} m)"
         )
     costs = path_costs(req, points, axis, clusters, directions, feasible)
-    return Candidates(points, mask, axis, axes[pl.pose_axis], clusters, directions, feasible, costs)
+    return Candidates(points, mask, axis, pose_axis, clusters, directions, feasible, costs)
+
+
+def pose_axis_source(pl, area_m: np.ndarray) -> str:
+    """Which cloud's main axis the grasp frame's X follows: ``object`` or ``area`` (``planner.pose_axis``;
+    ``area_if_elongated``: the area's when its :func:`.clusters.elongation` reaches
+    ``planner.pose_axis_min_elongation``)."""
+    if pl.pose_axis != "area_if_elongated":
+        return str(pl.pose_axis)
+    return "area" if elongation(area_m) >= pl.pose_axis_min_elongation else "object"
 
 
 def path_costs(

@@ -6,7 +6,9 @@ Output files (in ``<dir>/report/`` unless told otherwise)::
     table<N>_<dataset>_<planner>.*   success table: .md / .tex (paper layout), .csv (numeric), .png
     failures.{md,csv,tex}            failure-reason counts per setting
     runtime.{md,csv,tex}             planner wall time p50 / p95 against the paper's 0.1 s
-    strict.csv                       success by the paper's criterion and by the stricter slip one
+    strict.csv                       success by the paper's criterion, the stricter slip one and in the area
+    agreement_<dataset>_<planner>.*  per object and setting: ours beside the paper, Fisher's exact test
+                                     (.md / .csv / .png; agreement/*.png: a failure of each flagged cell)
     gallery.md, gallery/*.png        failure examples drawn from their logs (:mod:`.gallery`)
     unreadable.csv                   logs that could not be read (path, reason), if any
 """
@@ -16,12 +18,16 @@ from pathlib import Path
 
 import pandas as pd
 
+from graspexp.record import CorruptLogError, read_trial
+from graspexp.report.agreement import Agreement, agreement, agreement_chart, example_trials
 from graspexp.report.charts import success_chart
 from graspexp.report.collect import Collected, collect
-from graspexp.report.gallery import write_gallery
+from graspexp.report.contact_area import held_in_area
+from graspexp.report.gallery import draw_trial, write_gallery
 from graspexp.report.paper import PLANNER_RUNTIME_S
 from graspexp.report.render import display_frame, fmt_pct, footnotes, latex, markdown
 from graspexp.report.tables import (
+    IN_AREA_COLUMN,
     STRICT_SLIP_M,
     SuccessTable,
     failure_breakdown,
@@ -39,16 +45,22 @@ class Report:
     failures: pd.DataFrame
     runtime: pd.DataFrame
     strict: pd.DataFrame
-    """Success by the paper's criterion beside the stricter slip criterion, per setting."""
+    """Success by the paper's criterion beside the stricter slip criterion and in the area, per setting."""
+    agreements: list[Agreement]
+    """Per object agreement with the paper, one per table that reproduces a paper table."""
 
 
-def build_report(root: Path | str) -> Report:
-    """Collect every trial log below ``root`` and build all tables (nothing is written)."""
+def build_report(root: Path | str, progress: bool = True) -> Report:
+    """Collect every trial log below ``root`` and build all tables (nothing is written); the held trials'
+    logs are read again for the in-area criterion (``progress``: a progress bar on stderr)."""
     col = collect(root)
     df = col.results
     if df.empty:
-        return Report(col, [], pd.DataFrame(), pd.DataFrame(), pd.DataFrame())
-    return Report(col, success_tables(df), failure_breakdown(df), runtime_table(df), strict_table(df))
+        return Report(col, [], pd.DataFrame(), pd.DataFrame(), pd.DataFrame(), [])
+    df[IN_AREA_COLUMN] = held_in_area(df, progress)
+    tables = success_tables(df)
+    agreements = [a for a in map(agreement, tables) if a is not None]
+    return Report(col, tables, failure_breakdown(df), runtime_table(df), strict_table(df), agreements)
 
 
 def _runtime_display(rt: pd.DataFrame) -> pd.DataFrame:
@@ -82,6 +94,62 @@ def _unreadable_section(col: Collected) -> list[str]:
     return [*lines, ""]
 
 
+def _agreement_display(ag: Agreement, pictures: dict[tuple[str, str, str], str]) -> pd.DataFrame:
+    c = ag.cells
+    return pd.DataFrame(
+        {
+            "setting": c["setting"],
+            "object": c["label"],
+            "ours": [f"{k}/{n}" for k, n in zip(c["ours_k"], c["ours_n"], strict=True)],
+            "paper": [f"{k}/{n}" for k, n in zip(c["paper_k"], c["paper_n"], strict=True)],
+            "Δ (points)": [fmt_pct(v) for v in c["diff_pp"]],
+            "Fisher p (ours < paper)": [f"{p:.3g}" for p in c["p_below"]],
+            "below": ["**yes**" if f else "" for f in c["flagged"]],
+            "failure (most frequent)": [
+                r if f else "" for r, f in zip(c["top_reason"], c["flagged"], strict=True)
+            ],
+            "picture": [
+                pictures.get((m, r, o), "") for m, r, o in zip(c["mode"], c["rot"], c["object"], strict=True)
+            ],
+        }
+    )
+
+
+def _agreement_section(ag: Agreement, results: pd.DataFrame, out: Path) -> list[str]:
+    """Write ``agreement_<dataset>_<planner>.{md,csv,png}`` and a picture of each flagged cell's failure;
+    returns the report.md lines."""
+    pictures = {}
+    for key, row in example_trials(ag, results).items():
+        mode, rot, obj = key
+        name = f"{ag.dataset}_{ag.planner}_{mode}_{rot}_{obj}_{int(row['trial']):03d}"
+        try:
+            log = read_trial(row["path"])
+        except (CorruptLogError, OSError):
+            continue
+        title = f"{obj} · {mode} {rot} · {ag.planner} · trial {int(row['trial'])}: {row['reason']}"
+        draw_trial(log, out / "agreement" / f"{name}.png", title)
+        pictures[key] = f"![{name}](agreement/{name}.png)"
+    disp = _agreement_display(ag, pictures)
+    (out / f"{ag.name}.md").write_text(ag.summary() + "\n\n" + markdown(disp, index=False) + "\n")
+    ag.cells.to_csv(out / f"{ag.name}.csv", index=False)
+    agreement_chart(ag, out / f"{ag.name}.png")
+    flagged = disp[ag.cells["flagged"].to_numpy() | (ag.cells["object"] == "").to_numpy()]
+    return [
+        f"## Agreement with the paper: {ag.dataset}, planner {ag.planner}",
+        "",
+        ag.summary() + ".",
+        "",
+        "Cells significantly below the paper (one-sided Fisher's exact test, p < 0.05) and each setting's "
+        f"pooled row; every cell in [{ag.name}.md]({ag.name}.md) / `.csv`. The paper's numbers are its "
+        "10-trial rates as printed.",
+        "",
+        markdown(flagged, index=False),
+        "",
+        f"![{ag.name}]({ag.name}.png)",
+        "",
+    ]
+
+
 def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 2) -> str:
     """Write every file of the report into ``out_dir``; returns the Markdown of report.md.
 
@@ -108,6 +176,8 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
         md += [f"## {title}", "", markdown(disp), ""]
         md += [f"{i}. {note}" for i, note in enumerate(footnotes(table), 1)]
         md += ["", f"![{table.name}]({table.name}.png)", ""]
+    for ag in report.agreements:
+        md += _agreement_section(ag, col.results, out)
     if not report.failures.empty:
         (out / "failures.md").write_text(markdown(report.failures, index=False) + "\n")
         (out / "failures.tex").write_text(latex(report.failures, "Failure reasons per setting", index=False))
@@ -122,8 +192,13 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
         disp = report.strict.assign(
             held_pct=[fmt_pct(v) for v in report.strict["held_pct"]],
             strict_pct=[fmt_pct(v) for v in report.strict["strict_pct"]],
+            in_area_pct=[fmt_pct(v) for v in report.strict["in_area_pct"]],
         ).rename(
-            columns={"held_pct": "held (paper) %", "strict_pct": f"held, slip ≤ {STRICT_SLIP_M * 1e3:g} mm %"}
+            columns={
+                "held_pct": "held (paper) %",
+                "strict_pct": f"held, slip ≤ {STRICT_SLIP_M * 1e3:g} mm %",
+                "in_area_pct": "held, contacts in area %",
+            }
         )
         report.strict.to_csv(out / "strict.csv", index=False)
         md += [
@@ -134,7 +209,8 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
             "Paper IV-C: success = the object is still held after the support is removed (collab) or after "
             "the pull back (bin); the stricter column also needs the grasp point to have slid at most "
             f"{STRICT_SLIP_M * 1e3:g} mm over the object (each log's slip_m; `sim.slip_threshold_m` makes it "
-            "the criterion of a run).",
+            "the criterion of a run); the last also needs every finger contact at the end of closing in the "
+            "grasping area.",
             "",
         ]
     if not report.runtime.empty:

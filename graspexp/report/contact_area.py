@@ -17,13 +17,16 @@ import functools
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 from omegaconf import OmegaConf
 from scipy.spatial import cKDTree
+from tqdm import tqdm
 
 from graspexp.config import DatasetConfig
-from graspexp.datasets import load_object
+from graspexp.datasets import DatasetError, load_object
 from graspexp.geometry import make_pose, quat_wxyz_to_matrix, transform_points
-from graspexp.record import read_trial
+from graspexp.record import CorruptLogError, read_trial
+from graspexp.report.tables import IN_AREA_COLUMN
 from graspexp.seeding import cloud_seed
 
 IN_AREA_TOLERANCE_M = 0.005
@@ -86,3 +89,21 @@ def in_area(points_m: np.ndarray, area: cKDTree, tolerance_m: float = IN_AREA_TO
         return np.zeros(len(points_m), dtype=bool)
     distance, _ = area.query(points_m)
     return distance <= tolerance_m
+
+
+def held_in_area(results: pd.DataFrame, progress: bool = True) -> pd.Series:
+    """The report's second criterion for the collected ``results`` (columns ``success``, ``path``), one
+    value per row: held (the paper's criterion) with every finger contact at the end of closing in the
+    grasping area (:func:`finger_contacts_in_area`; a held trial without contacts then is not). Only held
+    trials' logs are read. None where it cannot be told: a log whose contacts cannot be read, or an object
+    whose mesh is not found (the reference cloud needs it: set ``GRASPEXP_DATA``)."""
+    out = pd.Series(False, index=results.index, name=IN_AREA_COLUMN, dtype=object)
+    held = results.index[results["success"].astype(bool)]
+    for i in tqdm(held, desc="contacts in the grasping area", unit="log", disable=not progress):
+        try:
+            n_in, n_all = finger_contacts_in_area(results.at[i, "path"])
+        except (CorruptLogError, OSError, DatasetError):
+            out.at[i] = None
+            continue
+        out.at[i] = bool(n_all > 0 and n_in == n_all)
+    return out

@@ -21,6 +21,9 @@ from graspexp.report.paper import (
 )
 from graspexp.report.stats import percentiles, success_pct
 
+IN_AREA_COLUMN = "held_in_area"
+"""Result column of the second criterion (:func:`graspexp.report.contact_area.held_in_area`): held with
+every finger contact in the grasping area; True / False / None (cannot be told)."""
 AVERAGE = "Average"
 AVERAGE_SAME = "Paper avg., same objects"
 
@@ -35,7 +38,8 @@ class SuccessTable:
     """The paper table this one reproduces, None for a dataset the paper does not report."""
     cells: pd.DataFrame
     """One row per (row label, setting): object (our id, or '' for average rows), label, mode, rot, n,
-    successes, ours_pct, lo_pct, hi_pct (Wilson 95 %), top_reason / top_reason_n (the most frequent
+    successes, ours_pct, lo_pct, hi_pct (Wilson 95 %), in_area_pct (held with every finger contact in the
+    grasping area, %; nan when unknown), top_reason / top_reason_n (the most frequent
     failure reason and its count; ties: the reason first in alphabetical order), paper_pct, delta_pp.
     n = 0 means no logs."""
     baselines: pd.DataFrame
@@ -54,6 +58,14 @@ def _settings_for(df: pd.DataFrame) -> list[tuple[str, str]]:
     return list(SETTINGS) + [s for s in seen if s not in SETTINGS]
 
 
+def _in_area_pct(sub: pd.DataFrame) -> float:
+    """% of the trials held with every finger contact in the grasping area; nan when any trial's value
+    is unknown (or the column is absent)."""
+    if IN_AREA_COLUMN not in sub or not len(sub) or sub[IN_AREA_COLUMN].isna().any():
+        return math.nan
+    return 100.0 * float(sub[IN_AREA_COLUMN].astype(bool).sum()) / len(sub)
+
+
 def _cell(sub: pd.DataFrame) -> dict:
     n, k = len(sub), int(sub["success"].sum())
     pct, lo_pct, hi_pct = success_pct(k, n)
@@ -65,6 +77,7 @@ def _cell(sub: pd.DataFrame) -> dict:
         "ours_pct": pct,
         "lo_pct": lo_pct,
         "hi_pct": hi_pct,
+        "in_area_pct": _in_area_pct(sub),
         "top_reason": str(reasons.index[0]) if len(reasons) else "",
         "top_reason_n": int(reasons.iloc[0]) if len(reasons) else 0,
     }
@@ -109,7 +122,8 @@ def success_table(df: pd.DataFrame, dataset: str, planner: str) -> SuccessTable:
             )
         pooled = _cell(in_setting[in_setting["object"].isin([o for o, _, _ in ran_here])])
         mean = float(np.mean([c["ours_pct"] for _, c, _ in ran_here])) if ran_here else math.nan
-        avg = {**pooled, "ours_pct": mean}
+        in_area = [c["in_area_pct"] for _, c, _ in ran_here]
+        avg = {**pooled, "ours_pct": mean, "in_area_pct": float(np.mean(in_area)) if in_area else math.nan}
         printed = paper.ours_average[si] if paper and si < len(SETTINGS) else math.nan
         same = [p for _, _, p in ran_here if not math.isnan(p)]
         records.append(
@@ -154,7 +168,7 @@ def setting_label(mode: str, rot: str) -> str:
 
 def wide_numeric(table: SuccessTable) -> pd.DataFrame:
     """The table in the paper's layout with numeric columns (for CSV): one row per row label."""
-    cols = ["n", "successes", "ours_pct", "lo_pct", "hi_pct", "paper_pct", "delta_pp"]
+    cols = ["n", "successes", "ours_pct", "lo_pct", "hi_pct", "in_area_pct", "paper_pct", "delta_pp"]
     parts = []
     for (mode, rot), sub in table.cells.groupby(["mode", "rot"], sort=False):
         part = sub.set_index("label")[cols]
@@ -195,17 +209,16 @@ STRICT_SLIP_M = 0.02
 
 
 def strict_table(df: pd.DataFrame, slip_m: float = STRICT_SLIP_M) -> pd.DataFrame:
-    """Per setting (dataset, planner, mode, rot): success % by the paper's criterion (still held) and by
-    the stricter one that also needs the logged slip (``slip_m`` of each trial, m) to be at most ``slip_m``."""
+    """Per setting (dataset, planner, mode, rot): success % by the paper's criterion (still held), by the
+    stricter one that also needs the logged slip (``slip_m`` of each trial, m) to be at most ``slip_m``, and
+    held with every finger contact in the grasping area (``in_area_pct``, nan when unknown)."""
     keys = ["dataset", "planner", "mode", "rot"]
     slip = pd.to_numeric(df["slip_m"], errors="coerce") if "slip_m" in df else pd.Series(math.nan, df.index)
     strict = df["success"] & (slip <= slip_m)
-    out = (
-        df.assign(strict=strict)
-        .groupby(keys, sort=False)
-        .agg(trials=("success", "size"), held_pct=("success", "mean"), strict_pct=("strict", "mean"))
-    )
+    groups = df.assign(strict=strict).groupby(keys, sort=False)
+    out = groups.agg(trials=("success", "size"), held_pct=("success", "mean"), strict_pct=("strict", "mean"))
     out[["held_pct", "strict_pct"]] *= 100.0
+    out["in_area_pct"] = groups.apply(_in_area_pct, include_groups=False)
     return out.sort_index(level=[0, 1]).reset_index()
 
 
