@@ -231,14 +231,20 @@ def test_the_area_rule_keeps_the_paper_planners_pads_in_the_area() -> None:
     assert min(shares["on"]) == 1.0
 
 
-def test_the_paper_planner_grasps_outside_the_area_only_through_the_fallback() -> None:
+def test_optimal_in_area_grasps_outside_the_area_only_through_the_fallback() -> None:
     # A 4 mm high ring at the can's base as the area: every pad touching it also touches the wall above.
     pts, normals = _cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
     area = pts[:, 2] < TABLE_Z + 0.004
     with pytest.raises(NoFeasibleGrasp, match=r"has less than 1.0 of a pad's contact in the grasping area"):
-        _plan_with("optimal", pts, normals, area, 1, "planner.swept_check=false")
+        _plan_with("optimal_in_area", pts, normals, area, 1, "planner.swept_check=false")
     g = _plan_with(
-        "optimal", pts, normals, area, 1, "planner.swept_check=false", "planner.fallback_contacts_in_area=0"
+        "optimal_in_area",
+        pts,
+        normals,
+        area,
+        1,
+        "planner.swept_check=false",
+        "planner.fallback_contacts_in_area=0",
     )
     assert g.extras["in_area_required"] < 1.0
     assert _pad_share(pts, normals, area, g) == pytest.approx(g.extras["in_area_required"])

@@ -105,6 +105,13 @@ def test_readings_table_rows_and_ceiling(readings_dir: Path, tmp_path: Path) -> 
     per = best.groupby(["object", "r"])["success"].mean().groupby("object").max() * 100
     np.testing.assert_allclose(ceiling.set_index("object")["best_pct"].sort_index(), per.sort_index())
     assert "default" in md and "literal" in md
+    # The second criterion beside each rate, and the grasp frame's X per object of the default reading.
+    assert table["in_area_pct"].between(0, 100).all()
+    assert (table["in_area_pct"] <= table["ours_pct"] + 1e-9).all()
+    axes = pd.read_csv(tmp_path / "area_axes.csv")
+    assert sorted(axes["object"]) == ["block", "box", "mug"]
+    assert (axes["elongation"] >= 1).all() and set(axes["pose_axis"]) <= {"object", "area"}
+    assert "The grasp frame's X per object" in md
 
 
 def test_a_reading_directory_with_two_configs_is_refused(readings_dir: Path, tmp_path: Path) -> None:

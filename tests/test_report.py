@@ -318,3 +318,22 @@ def test_in_area_criterion_is_na_where_it_cannot_be_told_and_zero_without_contac
     assert set(report.strict["in_area_pct"]) == {0.0}
     disp = display_frame(report.tables[0])
     assert disp.loc["Mug", "Z-Collab in area"] == "0"
+
+
+def test_compare_runs_matches_a_renamed_preset_cell_by_cell(tmp_path: Path, capsys) -> None:
+    from graspexp.bench.compare_runs import main as compare_main
+
+    rows = "dataset,object,planner,trial,success,timings_s\nycb,mug,{p},0,True,{{'plan': {t}}}\n"
+    for name, planner, t in (("before", "optimal", 0.1), ("after", "optimal_in_area", 0.2)):
+        job = tmp_path / name / f"dataset=ycb,mode=bin,planner={planner},rot=z"
+        job.mkdir(parents=True)
+        (job / "results.csv").write_text(rows.format(p=planner, t=t))
+    before, after = str(tmp_path / "before"), str(tmp_path / "after")
+    assert compare_main([before, after]) == 1  # other job directory names
+    assert compare_main([before, after, "--planner", "optimal=optimal_in_area"]) == 0
+    assert "1 trials: identical" in capsys.readouterr().out
+    (tmp_path / "after" / "dataset=ycb,mode=bin,planner=optimal_in_area,rot=z" / "results.csv").write_text(
+        rows.format(p="optimal_in_area", t=0.2).replace("True", "False")
+    )
+    assert compare_main([before, after, "--planner", "optimal=optimal_in_area"]) == 1
+    assert "success: 'True' != 'False'" in capsys.readouterr().out

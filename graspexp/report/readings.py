@@ -9,10 +9,12 @@ from pathlib import Path
 
 import pandas as pd
 
+from graspexp.report.area_axes import area_axes_frame
 from graspexp.report.collect import TRIAL_KEYS, collect
+from graspexp.report.contact_area import held_in_area
 from graspexp.report.paper import PAPER_TABLES, SETTINGS
 from graspexp.report.render import SHORT, fmt_ci, fmt_paper, fmt_pct, markdown
-from graspexp.report.tables import AVERAGE, AVERAGE_SAME, success_table
+from graspexp.report.tables import AVERAGE, AVERAGE_SAME, IN_AREA_COLUMN, success_table
 
 CEILING_KEYS = ("dataset", "object", "mode", "rot")
 
@@ -21,11 +23,14 @@ class MixedConfigError(ValueError):
     """A reading's directory holds results of more than one config."""
 
 
-def _results(name: str, root: Path) -> pd.DataFrame:
+def _results(name: str, root: Path, in_area: bool = False) -> pd.DataFrame:
+    """The reading's results; ``in_area``: with the second criterion read from the logs (none without)."""
     col = collect(root)
     df = col.results
     if df.empty:  # run with record=false: no trial logs, the runner's results.csv of each job instead
         df = _results_tables(name, root)
+    elif in_area:
+        df[IN_AREA_COLUMN] = held_in_area(df)
     if col.duplicates:
         raise MixedConfigError(
             f"reading {name!r}: {len(col.duplicates)} trials are logged twice below {root} "
@@ -59,12 +64,13 @@ def readings_frame(entries: dict[str, tuple[Path, str]]) -> tuple[pd.DataFrame, 
 
     entries : name -> (directory, one-line description). averages: one row per (reading, dataset, mode,
     rot) with n, successes, ours_pct, lo_pct, hi_pct (Wilson 95 %, pooled trials), paper_pct (the
-    paper's printed average) and paper_same_pct (the paper's mean over the objects run).
+    paper's printed average), paper_same_pct (the paper's mean over the objects run) and in_area_pct
+    (held with every finger contact in the grasping area, %; nan without logs).
     per-object: one row per (reading, dataset, object, mode, rot) with n and ours_pct.
     """
     avg_rows, obj_rows = [], []
     for name, (root, what) in entries.items():
-        df = _results(name, root)
+        df = _results(name, root, in_area=True)
         if df.empty:
             continue
         planner = str(df["planner"].iloc[0])
@@ -89,6 +95,7 @@ def readings_frame(entries: dict[str, tuple[Path, str]]) -> tuple[pd.DataFrame, 
                         "ours_pct": r["ours_pct"],
                         "lo_pct": r["lo_pct"],
                         "hi_pct": r["hi_pct"],
+                        "in_area_pct": r["in_area_pct"],
                         "paper_pct": r["paper_pct"],
                         "paper_same_pct": float(same["paper_pct"].iloc[0]) if len(same) else float("nan"),
                     }
@@ -122,9 +129,13 @@ def _averages_markdown(avg: pd.DataFrame, dataset: str) -> str:
         row = {"reading": head["reading"], "what": head["what"]}
         for s in settings:
             row[SHORT[s]] = (
-                fmt_ci(*mine.loc[s, ["ours_pct", "lo_pct", "hi_pct"]]) if s in mine.index else "n/a"
+                f"{fmt_ci(*mine.loc[s, ['ours_pct', 'lo_pct', 'hi_pct']])} · {fmt_pct(mine.loc[s, 'in_area_pct'])}"
+                if s in mine.index
+                else "n/a"
             )
-        row["mean of settings"] = fmt_pct(mine["ours_pct"].mean())
+        row["mean of settings"] = (
+            f"{fmt_pct(mine['ours_pct'].mean())} · {fmt_pct(mine['in_area_pct'].mean())}"
+        )
         row["trials"] = str(int(mine["n"].sum()))  # fewer than the others: a reading still running
         rows.append(row)
     return markdown(pd.DataFrame(rows).fillna(""), index=False)
@@ -178,7 +189,8 @@ def readings_report(entries: dict[str, tuple[Path, str]], out_dir: Path | str) -
         "# Readings of the paper, side by side",
         "",
         "Success rate (%) averaged over the paper's objects that were run, Wilson 95 % interval over the "
-        "pooled trials in brackets; one row per reading (one config, one directory each). Every reading is "
+        "pooled trials in brackets, then after · the rate held with every finger contact in the grasping "
+        "area (n/a without logs); one row per reading (one config, one directory each). Every reading is "
         "a single change from `default` unless it says otherwise; the last rows are other planners on the "
         "same drops.",
         "",
@@ -192,6 +204,33 @@ def readings_report(entries: dict[str, tuple[Path, str]], out_dir: Path | str) -
             _ceiling_markdown(ceil, dataset),
             "",
         ]
+    md += _area_axes_section(entries, out)
     text = "\n".join(md)
     (out / "readings.md").write_text(text)
     return text
+
+
+def _area_axes_section(entries: dict[str, tuple[Path, str]], out: Path) -> list[str]:
+    """Per object of the ``default`` reading's logs: the area's elongation and the axis ``pose_axis``
+    took (``area_axes.csv``); nothing without logs."""
+    if "default" not in entries:
+        return []
+    df = _results("default", entries["default"][0])
+    frame = area_axes_frame(df) if "path" in df else pd.DataFrame()
+    if frame.empty:
+        return []
+    frame.to_csv(out / "area_axes.csv", index=False)
+    disp = frame.sort_values(["dataset", "elongation"])
+    disp = disp.assign(
+        elongation=[f"{v:.2f}" for v in disp["elongation"]],
+        cos_area_object=[f"{v:.2f}" for v in disp["cos_area_object"]],
+    )
+    return [
+        "## The grasp frame's X per object (`default`)",
+        "",
+        "Elongation of the grasping area (sqrt(l1 / l2) of its covariance), |cos| of the angle between the "
+        "area's and the object's main axes, and the axis `planner.pose_axis` took.",
+        "",
+        markdown(disp, index=False),
+        "",
+    ]
