@@ -32,8 +32,8 @@ def lint(session: nox.Session) -> None:
 def bench(session: nox.Session) -> None:
     """Planner latency per Table 1 object, then the per-phase trial benchmark."""
     session.install("-e", ".")
-    session.run("python", "-m", "graspexp.bench.plan_latency", *session.posargs, env=ENV)
-    session.run("python", "-m", "graspexp.bench.trials", *session.posargs, env=ENV)
+    session.run("python", "-m", "graspexp", "bench.plan_latency", *session.posargs, env=ENV)
+    session.run("python", "-m", "graspexp", "bench.trials", *session.posargs, env=ENV)
 
 
 @nox.session(venv_backend="none")
@@ -49,21 +49,18 @@ def reproduce(session: nox.Session) -> None:
     """
     out = session.posargs[0] if session.posargs else "outputs/reproduce"
     extra = list(session.posargs[1:])
-    defaults = [
-        o
-        for o in ("trials=10", "planner=optimal,optimal_in_area")
-        if o.split("=")[0] + "=" not in {e.split("=")[0] + "=" for e in extra}
-    ]
+    suite = session.run("python", "-m", "graspexp.run.suites", silent=True, env=ENV, external=True)
+    given = {e.split("=")[0] for e in extra}
+    suite_overrides = [o for o in suite.split() if o.split("=")[0] not in given]
     start = time.perf_counter()
     session.run(
-        "python", "-m", "graspexp", "-m",
-        "mode=collab,bin", "rot=z,xyz", "dataset=ycb,linemod", *defaults, "progress=false",
+        "python", "-m", "graspexp", "-m", *suite_overrides, "progress=false",
         "hydra/launcher=joblib", f"hydra.sweep.dir={out}", *extra,
         env=ENV,
         external=True,
     )  # fmt: skip
     sweep_s = time.perf_counter() - start
-    session.run("python", "-m", "graspexp.report", out, env=ENV, external=True)
+    session.run("python", "-m", "graspexp", "report", out, env=ENV, external=True)
     total_s = time.perf_counter() - start
     session.log(
         f"reproduce: sweep {sweep_s:.1f} s, report {total_s - sweep_s:.1f} s, wall time {total_s:.1f} s"
@@ -73,7 +70,7 @@ def reproduce(session: nox.Session) -> None:
 @nox.session(venv_backend="none")
 def compare(session: nox.Session) -> None:
     """Six planners x pose noise on a small setting (primitives can/mug/banana, bin, rot z, 3 trials),
-    then ``python -m graspexp.compare``. ``nox -s compare -- DIR [overrides...]`` (default outputs/compare);
+    then ``python -m graspexp compare``. ``nox -s compare -- DIR [overrides...]`` (default outputs/compare);
     resumable."""
     out = session.posargs[0] if session.posargs else "outputs/compare"
     extra = list(session.posargs[1:])
@@ -86,14 +83,14 @@ def compare(session: nox.Session) -> None:
         "progress=false", "hydra/launcher=joblib", f"hydra.sweep.dir={out}", *extra,
         env=ENV, external=True,
     )  # fmt: skip
-    session.run("python", "-m", "graspexp.compare", out, "--out", f"{out}/compare", env=ENV, external=True)
+    session.run("python", "-m", "graspexp", "compare", out, "--out", f"{out}/compare", env=ENV, external=True)
     session.log(f"compare: {time.perf_counter() - start:.0f} s wall")
 
 
 @nox.session(venv_backend="none")
 def readings(session: nox.Session) -> None:
-    """Every reading of the paper and every other planner on Tables 1 and 2 (``python -m graspexp.readings``),
+    """Every reading of the paper and every other planner on Tables 1 and 2 (``python -m graspexp readings``),
     then the readings table. ``nox -s readings -- [OUT] [--only a,b] [--trials N]``; resumable."""
     start = time.perf_counter()
-    session.run("python", "-m", "graspexp.readings", *session.posargs, env=ENV, external=True)
+    session.run("python", "-m", "graspexp", "readings", *session.posargs, env=ENV, external=True)
     session.log(f"readings: {time.perf_counter() - start:.0f} s wall")

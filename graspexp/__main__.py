@@ -1,13 +1,20 @@
-"""Hydra entry point: ``python -m graspexp [group=option ...]`` (or the ``graspexp`` command) runs trials
-for every object; the command line is parsed and checked first by :func:`graspexp.cli.run_checked`."""
+"""Entry point: ``python -m graspexp [group=option ...]`` (or the ``graspexp`` command) runs trials for
+every object (the Hydra app; the command line is parsed and checked first by
+:func:`graspexp.tools.cli.run_checked`); ``python -m graspexp TOOL [...]`` runs one of
+:data:`graspexp.tools.TOOLS`."""
+
+import importlib
+import sys
+from collections.abc import Sequence
 
 import hydra
 from omegaconf import DictConfig
 
-from graspexp.cli import run_checked
 from graspexp.config import register_configs
 from graspexp.config.registry import CONF_DIR
-from graspexp.jobs import job_failed
+from graspexp.run.jobs import job_failed
+from graspexp.tools import TOOLS
+from graspexp.tools.cli import run_checked
 
 register_configs()
 
@@ -18,7 +25,7 @@ register_configs()
 def _job(cfg: DictConfig) -> float | None:
     from graspexp.datasets import DatasetError
     from graspexp.record.live import LiveViewError
-    from graspexp.runner import RunError, run_job
+    from graspexp.run.runner import RunError, run_job
 
     try:
         return run_job(cfg)
@@ -33,8 +40,12 @@ def _job(cfg: DictConfig) -> float | None:
     return None
 
 
-def main() -> None:
-    """Console-script entry (``graspexp``)."""
+def main(argv: Sequence[str] | None = None) -> None:
+    """Console-script entry (``graspexp``): a tool when the first word names one, else a job."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv and argv[0] in TOOLS:
+        tool = importlib.import_module(f"graspexp.tools.{argv[0]}")
+        raise SystemExit(tool.main(argv[1:]) or 0)
     run_checked(_job)
 
 

@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 from omegaconf import DictConfig
 
-from graspexp.cli import compose_config
+from graspexp.config.compose import compose_config
 
 REPO = Path(__file__).resolve().parent.parent
 

@@ -1,5 +1,6 @@
-"""The package's import graph: no cycle, and stages import one way
-(config -> datasets -> planning -> sim -> record -> report). Module-level and function-level imports count."""
+"""The package's import graph: no cycle (type-level imports included), stages import one way
+(config -> datasets -> planning -> sim -> record -> report -> run), the tools sit above every stage, and
+the package's top level holds only stage packages, the base package and the entry point."""
 
 import ast
 import subprocess
@@ -10,12 +11,14 @@ import graspexp
 
 PACKAGE = Path(graspexp.__file__).parent
 
-STAGES = ("config", "datasets", "planning", "sim", "record", "report")
+STAGES = ("config", "datasets", "planning", "sim", "record", "report", "run")
 """The stages in import order: a module of one stage imports only from its own stage or an earlier one."""
-STAGE_OF_PACKAGE = {**{s: s for s in STAGES}, "quality": "planning", "compare": "report"}
+STAGE_OF_PACKAGE = {**{s: s for s in STAGES}, "quality": "planning"}
 """Packages that belong to a stage without carrying its name (grasp quality is a planning-side check)."""
-BASE_MODULES = {"graspexp", "graspexp.geometry", "graspexp.seeding", "graspexp.outcome"}
-"""Modules every stage may import: they import no stage themselves."""
+BASE_PACKAGE = "core"
+"""Modules every stage may import (geometry, seeding, outcome, body names): they import no stage."""
+TOOLS_PACKAGE = "tools"
+"""Command-line tools: thin ``main(argv)`` functions above every stage; no stage imports them."""
 
 
 def _module_name(path: Path) -> str:
@@ -23,24 +26,12 @@ def _module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def _runtime_nodes(tree: ast.AST):
-    """Every node of ``tree`` except those under ``if TYPE_CHECKING:`` (annotations only, never imported)."""
-    for node in ast.iter_child_nodes(tree):
-        if (
-            isinstance(node, ast.If)
-            and getattr(node.test, "id", getattr(node.test, "attr", "")) == "TYPE_CHECKING"
-        ):
-            yield from (n for child in node.orelse for n in (child, *_runtime_nodes(child)))
-            continue
-        yield node
-        yield from _runtime_nodes(node)
-
-
 def _imports(path: Path, modules: set[str]) -> set[str]:
-    """graspexp modules imported anywhere in ``path`` at run time, module or function level (``from pkg
-    import mod`` resolves to the module)."""
+    """graspexp modules imported anywhere in ``path``: module or function level, and under
+    ``if TYPE_CHECKING:`` too (a type-level import is a dependency; ``from pkg import mod`` resolves to
+    the module)."""
     out = set()
-    for node in _runtime_nodes(ast.parse(path.read_text())):
+    for node in ast.walk(ast.parse(path.read_text())):
         if isinstance(node, ast.Import):
             names = [a.name for a in node.names]
         elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
@@ -57,28 +48,41 @@ def _graph() -> dict[str, set[str]]:
     return {name: _imports(path, set(files)) - {name} for name, path in files.items()}
 
 
-def _stage(module: str) -> str | None:
-    """The stage of ``module``; None for a tool (a top-level module, or a package's ``__main__``)."""
+def _kind(module: str) -> str:
+    """``stage:<name>``, ``base``, ``tool`` or ``entry`` (the package itself and its ``__main__``)."""
     parts = module.split(".")
-    return STAGE_OF_PACKAGE.get(parts[1]) if len(parts) > 1 and parts[-1] != "__main__" else None
+    if len(parts) == 1 or parts[1] == "__main__":
+        return "entry"
+    if parts[1] == BASE_PACKAGE:
+        return "base"
+    if parts[1] == TOOLS_PACKAGE:
+        return "tool"
+    return f"stage:{STAGE_OF_PACKAGE[parts[1]]}"
+
+
+def test_top_level_holds_only_packages_and_the_entry_point():
+    modules = sorted(p.name for p in PACKAGE.glob("*.py"))
+    assert modules == ["__init__.py", "__main__.py"], modules
+    packages = {p.name for p in PACKAGE.iterdir() if (p / "__init__.py").is_file()}
+    assert packages == {*STAGE_OF_PACKAGE, BASE_PACKAGE, TOOLS_PACKAGE}, packages
 
 
 def test_stages_import_one_way():
     graph = _graph()
     wrong = []
     for module, deps in graph.items():
-        stage = _stage(module)
+        kind = _kind(module)
         for dep in deps:
-            dep_stage = _stage(dep)
-            if module in BASE_MODULES and dep not in BASE_MODULES:
+            dep_kind = _kind(dep)
+            if kind == "base" and dep_kind != "base":
                 wrong.append(f"{module} (base) imports {dep}")
-            elif stage is not None and dep_stage is None and dep not in BASE_MODULES:
-                wrong.append(f"{module} ({stage}) imports the tool module {dep}")
-            elif stage is not None and dep_stage is not None:
-                if STAGES.index(dep_stage) > STAGES.index(stage):
-                    wrong.append(f"{module} ({stage}) imports {dep} ({dep_stage})")
+            elif kind.startswith("stage") and dep_kind in ("tool", "entry") and dep != "graspexp":
+                wrong.append(f"{module} ({kind}) imports the tool {dep}")
+            elif kind.startswith("stage") and dep_kind.startswith("stage"):
+                if STAGES.index(dep_kind[6:]) > STAGES.index(kind[6:]):
+                    wrong.append(f"{module} ({kind}) imports {dep} ({dep_kind})")
     assert not wrong, (
-        "imports against config -> datasets -> planning -> sim -> record -> report:\n"
+        "imports against config -> datasets -> planning -> sim -> record -> report -> run:\n"
         + "\n".join(sorted(wrong))
     )
 
@@ -110,3 +114,10 @@ def test_planning_loads_neither_hydra_nor_sapien():
     code = "import sys, graspexp.planning; print(sorted({m.split('.')[0] for m in sys.modules}))"
     loaded = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True).stdout
     assert "'hydra'" not in loaded and "'sapien'" not in loaded, loaded
+
+
+def test_tests_are_laid_out_by_stage():
+    tests = Path(__file__).parent
+    dirs = {p.name for p in tests.iterdir() if p.is_dir() and not p.name.startswith((".", "_"))}
+    assert dirs == {*STAGES, TOOLS_PACKAGE}, dirs
+    assert sorted(p.name for p in tests.glob("*.py")) == ["conftest.py", "test_architecture.py"]

@@ -24,8 +24,8 @@ SCHEMAS = {
 }
 """The schema of each group with one schema; the ``planner`` group has one per planner (its plugin's)."""
 
-CONF_DIR = str(Path(__file__).resolve().parent.parent.parent / "conf")
-"""The YAML config tree (``conf/<group>/<option>.yaml``)."""
+CONF_DIR = str(Path(__file__).resolve().parent.parent / "conf")
+"""The YAML config tree shipped inside the package (``graspexp/conf/<group>/<option>.yaml``)."""
 
 
 def _yaml_options(group: str) -> set[str]:

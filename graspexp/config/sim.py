@@ -69,7 +69,7 @@ class SimConfig:
     decimated, checked, and collided as a PhysX SDF triangle mesh), ``coacd`` or ``vhacd`` (convex
     decompositions). ``mesh`` is the one within 1 mm of every staged object: 90th percentile of the
     collision surface outside the mesh <= 0.26 mm on all 32, against 3.7-5.5 mm for CoACD at the
-    settings below (``python -m graspexp.bench.collision_shapes``)."""
+    settings below (``python -m graspexp bench.collision_shapes``)."""
     mesh_max_faces: int = 4000
     """``mesh``: first face budget for the quadric decimation of the repaired mesh. 4000 keeps every
     staged object but the bowl within 0.26 mm (p90) of the scan; 16k (no decimation) costs 1.5x per step

@@ -131,7 +131,7 @@ def dataset_spec(name: str) -> DatasetSpec:
 
 def download_command(name: str, root: Path | str) -> str:
     """The shell command that fetches dataset ``name`` into ``root``."""
-    return f"python -m graspexp.download dataset={name} dataset.root={root}"
+    return f"python -m graspexp download dataset={name} dataset.root={root}"
 
 
 def resolve_root(cfg: Any) -> Path:

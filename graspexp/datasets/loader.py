@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 import trimesh
 
+from graspexp.core.seeding import cloud_seed
 from graspexp.datasets.catalog import (
     LINEMOD_IDS,
     LINEMOD_MM_TO_M,
@@ -28,7 +29,6 @@ from graspexp.datasets.meshcheck import check_bop_info, check_file, check_geomet
 from graspexp.datasets.model import ObjectModel
 from graspexp.datasets.primitives import PRIMITIVES
 from graspexp.datasets.regions import area_mask, load_region_specs, regions_path
-from graspexp.seeding import cloud_seed
 
 log = logging.getLogger(__name__)
 
@@ -142,7 +142,7 @@ def load_object(cfg: Any, name: str, n_points: int, seed: int) -> ObjectModel:
 
     n_points : number of surface samples (>= 1).
     seed : seeds ``trimesh.sample.sample_surface`` (the same seed gives the same cloud; the global
-        ``np.random`` is never used). Derive it with :func:`graspexp.seeding.derive_seed`.
+        ``np.random`` is never used). Derive it with :func:`graspexp.core.seeding.derive_seed`.
     The grasping area comes from the spec file ``cfg.regions`` (see :mod:`graspexp.datasets.regions`).
     """
     if isinstance(n_points, bool) or not isinstance(n_points, int | np.integer) or n_points < 1:
@@ -174,8 +174,8 @@ def load_object(cfg: Any, name: str, n_points: int, seed: int) -> ObjectModel:
 
 def job_object(job: Any, name: str) -> ObjectModel:
     """Object ``name`` as every trial of job config ``job`` sees it: dataset ``job.dataset``, a cloud of
-    ``job.planner.n_points`` samples seeded by :func:`graspexp.seeding.cloud_seed` (the same cloud
-    for every trial of the object, in the runner, ``graspexp.plan``, re-simulation and the benches)."""
+    ``job.planner.n_points`` samples seeded by :func:`graspexp.core.seeding.cloud_seed` (the same cloud
+    for every trial of the object, in the runner, ``graspexp.tools.plan``, re-simulation and the benches)."""
     return load_object(job.dataset, name, int(job.planner.n_points), cloud_seed(job, name))
 
 
@@ -196,7 +196,7 @@ def select_objects(dataset: Any, objects: list[str] | None) -> list[str]:
     if missing:
         log.warning(
             "dataset %s: no mesh for %s under the data root; skipping them (get them with "
-            "`python -m graspexp.download dataset=%s`)",
+            "`python -m graspexp download dataset=%s`)",
             dataset.name,
             missing,
             dataset.name,

@@ -51,7 +51,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from graspexp.config.gripper import GripperGeometry
-from graspexp.geometry import make_pose
+from graspexp.core.geometry import make_pose
+from graspexp.core.seeding import derive_seed
 from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
 from graspexp.planning.clusters import Clusters, choose_k, elongation, main_axis, max_radii_m, segment
 from graspexp.planning.collision import cloud_hits, lowest_z
@@ -61,7 +62,6 @@ from graspexp.planning.paths import above_support, approach_directions
 from graspexp.planning.pose import grasp_rotation, grasp_rotations, opening_widths_m, slab_spans_m
 from graspexp.planning.request import PlanRequest, PlanResult
 from graspexp.planning.stability import pad_contacts
-from graspexp.seeding import derive_seed
 
 NAME = "optimal"
 LITERAL_NAME = "optimal_literal"

@@ -50,13 +50,14 @@ paper's, inf where removed by the plane test), ``feasible`` (K, M), ``pose_axis`
 ``mode``, ``table_z``, ``sphere_radius``, ``gripper_max_width``) plus ``com`` (3,) and the S
 shortlisted paths' ``shortlist_poses`` (S, 4, 4), ``shortlist_widths`` (S,) m, ``shortlist_costs`` (S,, step
 4), ``shortlist_robust`` (S,) bool, ``shortlist_edge_excess_m`` (S,) and ``shortlist_pad_depth_m`` (S,)
-(:mod:`graspexp.bench.shortlist` simulates each of them).
+(:mod:`graspexp.tools.bench.shortlist` simulates each of them).
 """
 
 import numpy as np
 
 from graspexp.config.gripper import GripperGeometry
-from graspexp.geometry import transform_points
+from graspexp.core.geometry import transform_points
+from graspexp.core.seeding import rng_for
 from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
 from graspexp.planning.collision import cloud_hits, place_for_request
 from graspexp.planning.friction import cone_cosine
@@ -71,7 +72,6 @@ from graspexp.planning.stability import (
     pose_perturbations,
     volume_centroid_m,
 )
-from graspexp.seeding import rng_for
 
 NAME = "optimal_plus"
 
@@ -284,7 +284,7 @@ def _pads_hold(
 
 def _roll(angle_rad: float) -> np.ndarray:
     """(3, 3) rotation of a grasp frame about its own approach axis +Z by ``angle_rad``. Written out, not
-    :func:`graspexp.geometry.yaw_rotation`: its Rodrigues form leaves cos(90 deg) = 0 where this keeps
+    :func:`graspexp.core.geometry.yaw_rotation`: its Rodrigues form leaves cos(90 deg) = 0 where this keeps
     6e-17, and the benchmark's grasps were planned with this one."""
     c, s = np.cos(angle_rad), np.sin(angle_rad)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])

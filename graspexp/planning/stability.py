@@ -30,7 +30,7 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
 from graspexp.config.gripper import GripperGeometry
-from graspexp.geometry import axis_angle_matrix
+from graspexp.core.geometry import axis_angle_matrix
 from graspexp.planning.kernels import pad_contact_stats, pad_edge_excess
 
 

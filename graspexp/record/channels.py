@@ -1,7 +1,5 @@
 """The channels of a trial log: every topic of :mod:`graspexp.record.schemas` on one ``foxglove.Context``."""
 
-import functools
-
 import foxglove
 from foxglove.channels import (
     FrameTransformsChannel,
@@ -10,17 +8,11 @@ from foxglove.channels import (
     SceneUpdateChannel,
 )
 
+from graspexp.core.bodies import FINGER_NAMES, GROUND_NAME, OBJECT_NAME, PALM_NAME, SUPPORT_NAME
 from graspexp.record import schemas as S
 
-
-@functools.cache
-def body_names() -> tuple[str, ...]:
-    """The physics bodies that can touch, in /contacts index order (imported here, not at module level, so
-    that reading logs does not load the simulator)."""
-    from graspexp.sim.gripper import FINGER_NAMES, PALM_NAME
-    from graspexp.sim.scene import GROUND_NAME, OBJECT_NAME, SUPPORT_NAME
-
-    return (OBJECT_NAME, SUPPORT_NAME, GROUND_NAME, PALM_NAME, *FINGER_NAMES)
+BODY_NAMES: tuple[str, ...] = (OBJECT_NAME, SUPPORT_NAME, GROUND_NAME, PALM_NAME, *FINGER_NAMES)
+"""The physics bodies that can touch, in /contacts index order."""
 
 
 class Channels:
@@ -30,7 +22,7 @@ class Channels:
         self.context = context
         self.tf = FrameTransformsChannel(S.TOPIC_TF, context=context)
         self.contacts = PointCloudChannel(
-            S.TOPIC_CONTACTS, metadata={"bodies": ",".join(body_names())}, context=context
+            S.TOPIC_CONTACTS, metadata={"bodies": ",".join(BODY_NAMES)}, context=context
         )
         self.scene = SceneUpdateChannel(S.TOPIC_SCENE, context=context)
         self.grasp_pose = PoseInFrameChannel(S.TOPIC_GRASP_POSE, context=context)

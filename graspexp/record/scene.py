@@ -24,9 +24,8 @@ from foxglove.messages import (
 
 from graspexp.config import JobConfig
 from graspexp.config.gripper import GripperGeometry
+from graspexp.core.bodies import FINGER_NAMES, OBJECT_NAME, PALM_NAME, SUPPORT_NAME
 from graspexp.sim.collision_shapes import hull_meshes
-from graspexp.sim.gripper import FINGER_NAMES, PALM_NAME
-from graspexp.sim.scene import OBJECT_NAME, SUPPORT_NAME
 
 SCENE_DECIMALS = 6
 """Mesh vertices are rounded to this many decimals of a metre (1 um)."""

@@ -18,7 +18,7 @@ import math
 import types
 import typing
 
-from graspexp.outcome import TrialResult
+from graspexp.core.outcome import TrialResult
 
 SCHEMA_ENCODING = "jsonschema"
 MESSAGE_ENCODING = "json"
@@ -89,7 +89,7 @@ CONTACT_FLOATS = (
 """/contacts is a foxglove.PointCloud in the world frame, one point per touching body pair: these float32
 fields (position m, unit normal, force on body0 N, signed separation m), then ``body0`` and ``body1`` as
 uint8 indices into the body names stored as the channel's metadata ``bodies`` (comma-separated; see
-:func:`graspexp.record.channels.body_names`), padded to :data:`CONTACT_STRIDE` bytes."""
+:data:`graspexp.record.channels.BODY_NAMES`), padded to :data:`CONTACT_STRIDE` bytes."""
 CONTACT_BODIES = ("body0", "body1")
 CONTACT_STRIDE = 4 * len(CONTACT_FLOATS) + 4
 CONTACT_FORMAT = f"<{len(CONTACT_FLOATS)}f2B2x"
@@ -199,7 +199,7 @@ def _trial_result() -> dict:
     return {
         "$schema": "https://json-schema.org/draft/2020-12/schema",
         "title": TRIAL_RESULT,
-        "description": "graspexp.outcome.TrialResult.to_dict(); NaN floats are encoded as null.",
+        "description": "graspexp.core.outcome.TrialResult.to_dict(); NaN floats are encoded as null.",
         "type": "object",
         "properties": {f.name: _annotation_schema(hints[f.name]) for f in fields},
         "required": [f.name for f in fields],

@@ -48,9 +48,9 @@ from foxglove.messages import (
     Vector3,
 )
 
-from graspexp.geometry import matrix_to_quat_wxyz
+from graspexp.core.geometry import matrix_to_quat_wxyz
 from graspexp.record import schemas as S
-from graspexp.record.channels import Channels, body_names
+from graspexp.record.channels import BODY_NAMES, Channels
 from graspexp.record.live import live_channels
 
 if TYPE_CHECKING:
@@ -110,7 +110,7 @@ def to_json_value(value: Any) -> Any:
 
 @functools.cache
 def _body_ids() -> dict[str, int]:
-    return {name: i for i, name in enumerate(body_names())}
+    return {name: i for i, name in enumerate(BODY_NAMES)}
 
 
 def _contact_point(c: Mapping[str, Any]) -> bytes:
@@ -129,7 +129,7 @@ def _contact_point(c: Mapping[str, Any]) -> bytes:
         ids = _body_ids()
         bodies = ids[c["body0"]], ids[c["body1"]]
     except KeyError as exc:
-        raise ValueError(f"contact body {exc.args[0]!r} is not one of {body_names()}") from None
+        raise ValueError(f"contact body {exc.args[0]!r} is not one of {BODY_NAMES}") from None
     return _CONTACT.pack(*position, *normal, *force, float(c.get("separation_m", 0.0)), *bodies)
 
 
@@ -146,7 +146,7 @@ class TrialWriter:
     """
 
     active = True
-    """Every message is kept (:class:`graspexp.sim.trial.TrialLog`)."""
+    """Every message is kept (:class:`graspexp.sim.trial.LogSink`)."""
 
     def __init__(
         self, stream: IO[bytes] | None, metadata: Mapping[str, str], channels: Channels | None = None
@@ -221,7 +221,7 @@ class TrialWriter:
     def contacts(self, t_s: float, contacts: Sequence[Mapping[str, Any]]) -> None:
         """/contacts, foxglove.PointCloud in ``world``: one point per contact (drawn in Foxglove's 3D panel).
 
-        Each mapping: body0, body1 (names from :func:`body_names`), position (3,)
+        Each mapping: body0, body1 (names from :data:`BODY_NAMES`), position (3,)
         world m, normal (3,) world, force_n: (3,) world-frame force on body0 in N, or a scalar magnitude
         along ``normal``; separation_m (float, default 0). Stored as float32, as PhysX reports contacts.
         """

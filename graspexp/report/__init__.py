@@ -1,5 +1,5 @@
 """Reports from trial logs: the paper's Tables 1 and 2 with our numbers beside the paper's, Wilson
-intervals, failure reasons, planner runtime and bar charts (``python -m graspexp.report DIR``)."""
+intervals, failure reasons, planner runtime and bar charts (``python -m graspexp report DIR``)."""
 
 from graspexp.report.build import Report, build_report, write_report
 from graspexp.report.collect import Collected, collect, find_trial_logs

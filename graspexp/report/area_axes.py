@@ -10,11 +10,11 @@ import pandas as pd
 from omegaconf import OmegaConf
 
 from graspexp.config import DatasetConfig
+from graspexp.core.seeding import cloud_seed
 from graspexp.datasets import DatasetError, load_object
 from graspexp.planning.clusters import elongation, main_axis
 from graspexp.planning.optimal import pose_axis_source
 from graspexp.record import CorruptLogError, read_trial
-from graspexp.seeding import cloud_seed
 
 
 def area_axes_frame(results: pd.DataFrame) -> pd.DataFrame:

@@ -1,32 +1,43 @@
-"""Find the trial logs below a run or multirun directory and read their results into one DataFrame.
+"""The one results reader: every trial below a run or multirun directory, in one DataFrame.
 
-The MCAP logs are the source of truth (``results.csv`` in a run directory is only a cache): every
-``trials/<object>/<NNN>.mcap`` below the directory is read with :func:`graspexp.record.read_result`.
-A log that cannot be read (truncated, corrupt, an unfinished ``.partial`` file) is never dropped
-silently: it is returned in :attr:`Collected.unreadable` with the reason, for the report to name.
+The MCAP logs are the source of truth: every ``trials/<object>/<NNN>.mcap`` below the directory is read
+with :func:`graspexp.record.read_result`, and its pose-noise level (``perception.noise.trans_mm``, mm,
+``rot_deg``, degrees; 0 when absent) from the log's recorded config. ``results.csv`` is a cache: it is
+read only for a run directory that holds no logs (a run with ``record=false``), with its noise level from
+the run's ``.hydra/config.yaml``. A log that cannot be read (truncated, corrupt, an unfinished
+``.partial`` file) is never dropped silently: it is returned in :attr:`Collected.unreadable` with the
+reason, for the tools to name. The report, the planner comparison, the benchmark and the readings all
+read their results here.
 """
 
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
+import yaml
 
 from graspexp.record import TRIALS_DIR, CorruptLogError, read_result
+from graspexp.record.reader import read_config_yaml
 from graspexp.record.writer import PARTIAL_SUFFIX
 
 SETTING_KEYS: tuple[str, ...] = ("dataset", "planner", "mode", "rot")
 """A setting (one table cell column group) is identified by these result fields."""
-TRIAL_KEYS: tuple[str, ...] = (*SETTING_KEYS, "object", "trial")
-"""One trial is identified by these result fields."""
+NOISE_KEYS: tuple[str, ...] = ("trans_mm", "rot_deg")
+"""The pose-noise level of a trial's run (``perception.noise``): mm and degrees."""
+TRIAL_KEYS: tuple[str, ...] = (*SETTING_KEYS, *NOISE_KEYS, "object", "trial")
+"""One trial is identified by these fields."""
+RESULTS_CSV = "results.csv"
+"""The runner's per-run cache of its trials' results."""
 
 
 @dataclass
 class Collected:
-    """The results read from every trial log below a directory."""
+    """The results read from every trial below a directory."""
 
     root: Path
     results: pd.DataFrame
-    """One row per readable log: TrialResult fields, ``plan_ms`` (timings_s.plan in ms) and ``path``."""
+    """One row per trial: TrialResult fields, ``plan_ms`` (timings_s.plan in ms), ``trans_mm``,
+    ``rot_deg`` and ``path`` (its log; empty for a row read from results.csv)."""
     unreadable: list[tuple[Path, str]] = field(default_factory=list)
     """(path, reason) for each log that could not be read."""
     duplicates: list[tuple[Path, Path]] = field(default_factory=list)
@@ -44,33 +55,64 @@ def find_trial_logs(root: Path | str) -> list[Path]:
     return sorted(found)
 
 
-def _row(result: dict, path: Path) -> dict:
+def noise_of(config: dict | None) -> tuple[float, float]:
+    """(trans_mm, rot_deg) of a job config as a plain dict; 0 for a key it lacks."""
+    noise = ((config or {}).get("perception") or {}).get("noise") or {}
+    return float(noise.get("trans_mm", 0.0)), float(noise.get("rot_deg", 0.0))
+
+
+def _row(result: dict, path: Path | str, noise: tuple[float, float]) -> dict:
     row = {k: v for k, v in result.items() if k not in ("timings_s", "finger_force_n")}
     timings = result.get("timings_s") or {}
     plan_s = timings.get("plan")
     row["plan_ms"] = float("nan") if plan_s is None else 1e3 * float(plan_s)
+    row["trans_mm"], row["rot_deg"] = noise
     row["path"] = str(path)
     return row
 
 
-def collect(root: Path | str) -> Collected:
-    """Read the result of every trial log below ``root`` (a run directory or a multirun directory)."""
-    root = Path(root)
+def _log_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
     rows, unreadable = [], []
     for path in find_trial_logs(root):
         try:
             result = read_result(path)
-            missing = [k for k in (*TRIAL_KEYS, "success") if k not in result]
+            missing = [k for k in (*SETTING_KEYS, "object", "trial", "success") if k not in result]
             if missing:
                 raise CorruptLogError(f"{path}: /result lacks {missing}")
-        except (CorruptLogError, OSError) as exc:
+            noise = noise_of(yaml.safe_load(read_config_yaml(path) or "") or {})
+        except (CorruptLogError, OSError, yaml.YAMLError) as exc:
             unreadable.append((path, str(exc)))
             continue
-        rows.append(_row(result, path))
+        rows.append(_row(result, path, noise))
+    return rows, unreadable
+
+
+def _csv_rows(root: Path) -> list[dict]:
+    """Rows of every results.csv below ``root`` whose run directory holds no trial log."""
+    rows = []
+    for table in sorted(root.rglob(RESULTS_CSV)):
+        run_dir = table.parent
+        if (run_dir / TRIALS_DIR).is_dir() and find_trial_logs(run_dir):
+            continue
+        hydra_cfg = run_dir / ".hydra" / "config.yaml"
+        noise = noise_of(yaml.safe_load(hydra_cfg.read_text())) if hydra_cfg.is_file() else (0.0, 0.0)
+        for result in pd.read_csv(table).to_dict("records"):
+            timings = result.get("timings_s")
+            result["timings_s"] = yaml.safe_load(timings) if isinstance(timings, str) else None
+            rows.append(_row(result, "", noise))
+    return rows
+
+
+def collect(root: Path | str) -> Collected:
+    """Read every trial below ``root`` (a run directory or a multirun directory): logs first, results.csv
+    where a run has none (module doc)."""
+    root = Path(root)
+    rows, unreadable = _log_rows(root)
+    rows += _csv_rows(root)
     df = pd.DataFrame(rows)
     duplicates: list[tuple[Path, Path]] = []
     if not df.empty:
-        df["success"] = df["success"].astype(bool)
+        df["success"] = df["success"].astype(str).str.lower().isin(("true", "1", "1.0"))
         df["trial"] = df["trial"].astype(int)
         dup = df.duplicated(list(TRIAL_KEYS), keep="first")
         if dup.any():

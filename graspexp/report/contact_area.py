@@ -23,11 +23,12 @@ from scipy.spatial import cKDTree
 from tqdm import tqdm
 
 from graspexp.config import DatasetConfig
+from graspexp.core.bodies import FINGER_NAMES, OBJECT_NAME
+from graspexp.core.geometry import make_pose, quat_wxyz_to_matrix, transform_points
+from graspexp.core.seeding import cloud_seed
 from graspexp.datasets import DatasetError, load_object
-from graspexp.geometry import make_pose, quat_wxyz_to_matrix, transform_points
 from graspexp.record import CorruptLogError, read_trial
 from graspexp.report.tables import IN_AREA_COLUMN
-from graspexp.seeding import cloud_seed
 
 IN_AREA_TOLERANCE_M = 0.005
 """A contact within this of a grasping-area point is in the area, m: a contact on an area face counts
@@ -37,8 +38,6 @@ AREA_REFERENCE_POINTS = 20_000
 """Size of the reference cloud the contacts are measured against: on every Table 1/2 object 99 % of the
 area's surface lies within 2.8 mm of a reference area point (the largest gap: 4.9 mm, on the iron), inside
 the tolerance (measured against 200 000 surface points)."""
-FINGERS = ("finger_left", "finger_right")
-OBJECT = "object"
 
 
 @functools.lru_cache(maxsize=64)
@@ -57,7 +56,7 @@ def finger_contacts_in_area(path: Path | str) -> tuple[int, int]:
     (0, 0) for a trial that never closed or whose fingers do not touch the object then."""
     log = read_trial(path)
     names = [n for _, n, _ in log.phases]
-    if "close" not in names or OBJECT not in log.transforms:
+    if "close" not in names or OBJECT_NAME not in log.transforms:
         return 0, 0
     i = names.index("close")
     end = log.phases[i + 1][0] if i + 1 < len(log.phases) else np.inf
@@ -68,11 +67,11 @@ def finger_contacts_in_area(path: Path | str) -> tuple[int, int]:
     pairs = [
         c
         for c in before[-1]
-        if {c["body0"], c["body1"]} & set(FINGERS) and OBJECT in (c["body0"], c["body1"])
+        if {c["body0"], c["body1"]} & set(FINGER_NAMES) and OBJECT_NAME in (c["body0"], c["body1"])
     ]
     if not pairs:
         return 0, 0
-    times, pos, quat = log.transforms[OBJECT]
+    times, pos, quat = log.transforms[OBJECT_NAME]
     j = _at(times, t_end)
     world_from_object = make_pose(quat_wxyz_to_matrix(quat[j]), pos[j])
     local = transform_points(np.linalg.inv(world_from_object), np.array([c["position"] for c in pairs]))

@@ -18,11 +18,11 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
-from graspexp.geometry import make_pose, quat_wxyz_to_matrix  # noqa: E402
+from graspexp.core.geometry import make_pose, quat_wxyz_to_matrix  # noqa: E402
 from graspexp.record import CorruptLogError, TrialLog, read_trial  # noqa: E402
+from graspexp.report.collect import SETTING_KEYS  # noqa: E402
 from graspexp.report.render import markdown  # noqa: E402
 
-SETTING_KEYS = ["dataset", "planner", "mode", "rot"]
 VIEW_HALF_M = 0.13
 """Half the side of the cube drawn around the planned grasp point, m."""
 AXIS_LEN_M = 0.04

@@ -10,7 +10,7 @@ from pathlib import Path
 import pandas as pd
 
 from graspexp.report.area_axes import area_axes_frame
-from graspexp.report.collect import TRIAL_KEYS, collect
+from graspexp.report.collect import collect
 from graspexp.report.contact_area import held_in_area
 from graspexp.report.paper import PAPER_TABLES, SETTINGS
 from graspexp.report.render import SHORT, fmt_ci, fmt_paper, fmt_pct, markdown
@@ -24,38 +24,24 @@ class MixedConfigError(ValueError):
 
 
 def _results(name: str, root: Path, in_area: bool = False) -> pd.DataFrame:
-    """The reading's results; ``in_area``: with the second criterion read from the logs (none without)."""
+    """The reading's results (:func:`graspexp.report.collect.collect`); ``in_area``: with the second
+    criterion read from the logs (none for rows without a log)."""
     col = collect(root)
     df = col.results
-    if df.empty:  # run with record=false: no trial logs, the runner's results.csv of each job instead
-        df = _results_tables(name, root)
-    elif in_area:
-        df[IN_AREA_COLUMN] = held_in_area(df)
     if col.duplicates:
         raise MixedConfigError(
-            f"reading {name!r}: {len(col.duplicates)} trials are logged twice below {root} "
+            f"reading {name!r}: {len(col.duplicates)} trials are recorded twice below {root} "
             f"(e.g. {col.duplicates[0][0]}): one directory must hold one config"
         )
     if not df.empty and df["planner"].nunique() > 1:
         raise MixedConfigError(
             f"reading {name!r}: {root} holds planners {sorted(df['planner'].unique())}: one directory per reading"
         )
-    return df
-
-
-def _results_tables(name: str, root: Path) -> pd.DataFrame:
-    """Every ``results.csv`` below ``root`` in one frame (empty when there is none); a trial listed twice
-    is refused as for logs."""
-    tables = [pd.read_csv(p) for p in sorted(Path(root).rglob("results.csv"))]
-    if not tables:
-        return pd.DataFrame()
-    df = pd.concat(tables, ignore_index=True)
-    df["success"] = df["success"].astype(bool)
-    if df.duplicated(list(TRIAL_KEYS)).any():
-        raise MixedConfigError(
-            f"reading {name!r}: trials are listed twice in the results.csv files below {root}: one "
-            "directory must hold one config"
-        )
+    if in_area and not df.empty:
+        logged = df["path"] != ""
+        df[IN_AREA_COLUMN] = None
+        if logged.any():
+            df.loc[logged, IN_AREA_COLUMN] = held_in_area(df[logged])
     return df
 
 
@@ -216,7 +202,7 @@ def _area_axes_section(entries: dict[str, tuple[Path, str]], out: Path) -> list[
     if "default" not in entries:
         return []
     df = _results("default", entries["default"][0])
-    frame = area_axes_frame(df) if "path" in df else pd.DataFrame()
+    frame = area_axes_frame(df[df["path"] != ""]) if not df.empty else pd.DataFrame()
     if frame.empty:
         return []
     frame.to_csv(out / "area_axes.csv", index=False)

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from graspexp.outcome import FailureReason
+from graspexp.core.outcome import FailureReason
 from graspexp.report.paper import (
     BASELINES,
     PAPER_TABLES,

@@ -15,13 +15,11 @@ vertex every adjacent face gives the same sign.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 import trimesh
 
-if TYPE_CHECKING:  # collision_shapes imports this module to check the shapes it makes
-    from graspexp.sim.collision_shapes import CollisionShape
+from graspexp.sim.shape import CollisionShape
 
 _ON_HULL_M = 1e-5
 """Tolerance for a sample to lie on another hull's boundary, m."""

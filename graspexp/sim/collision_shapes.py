@@ -20,33 +20,15 @@ import os
 import sys
 import tempfile
 from contextlib import contextmanager
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import trimesh
 
 from graspexp.config import SimConfig
+from graspexp.sim.shape import CollisionShape
 
 METHODS = ("mesh", "coacd", "vhacd")
-
-
-@dataclass(frozen=True)
-class CollisionShape:
-    """An object's collision geometry in the object frame, metres."""
-
-    method: str
-    """The ``sim.collision_method`` it was made for (one of :data:`METHODS`)."""
-    parts: tuple[tuple[np.ndarray, np.ndarray], ...]
-    """(vertices (V, 3) float32, faces (F, 3) int64) per part: convex hulls, or one closed mesh."""
-    convex: bool
-    """True: every part is a convex hull (PhysX convex shapes). False: one closed triangle mesh."""
-    mesh_file: Path | None = None
-    """The OBJ file of the closed mesh that SAPIEN cooks once per process; None for hulls."""
-
-    def meshes(self) -> list[trimesh.Trimesh]:
-        """The parts as triangle meshes (object frame, metres)."""
-        return [trimesh.Trimesh(v, f, process=False) for v, f in self.parts]
 
 
 def cache_dir(cfg: SimConfig) -> Path:

@@ -9,8 +9,7 @@ import math
 import numpy as np
 import sapien
 
-from graspexp.sim.gripper import FINGER_NAMES, PALM_NAME
-from graspexp.sim.scene import OBJECT_NAME
+from graspexp.core.bodies import FINGER_NAMES, OBJECT_NAME, PALM_NAME
 
 GRIPPER_LINKS = frozenset({*FINGER_NAMES, PALM_NAME})
 MIN_IMPULSE_NS = 1e-9

@@ -16,7 +16,8 @@ import numpy as np
 import sapien
 
 from graspexp.config.gripper import GripperConfig, GripperGeometry
-from graspexp.geometry import matrix_to_quat_wxyz
+from graspexp.core.bodies import FINGER_NAMES, PALM_NAME
+from graspexp.core.geometry import matrix_to_quat_wxyz
 from graspexp.sim.scene import GRIPPER_BIT, OBJECT_BIT, SUPPORT_BIT, set_groups
 
 # wxyz quaternions that turn a joint's +x axis onto the named axis
@@ -26,8 +27,6 @@ _AXIS_Q = {
     "-y": [np.cos(np.pi / 4), 0.0, 0.0, -np.sin(np.pi / 4)],
     "z": [np.cos(np.pi / 4), 0.0, -np.sin(np.pi / 4), 0.0],
 }
-FINGER_NAMES = ("finger_left", "finger_right")
-PALM_NAME = "palm"
 N_BASE = 6
 """Base joints before the two fingers: 3 prismatic then 3 revolute."""
 
@@ -145,7 +144,7 @@ def build_gripper(
     links = {lk.name: lk for lk in art.links}
     # couple the fingers like a real parallel gripper's linkage: q_left - q_right -> 0, stiffly
     art.create_fixed_tendon(
-        [links[PALM_NAME], links["finger_left"], links["finger_right"]],
+        [links[PALM_NAME], links[FINGER_NAMES[0]], links[FINGER_NAMES[1]]],
         [0.0, 1.0, -1.0],
         [0.0, 1.0, -1.0],
         stiffness=cfg.coupling_stiffness_n_per_m,
@@ -154,7 +153,7 @@ def build_gripper(
     return Gripper(
         articulation=art,
         palm=links[PALM_NAME],
-        fingers=(links["finger_left"], links["finger_right"]),
+        fingers=(links[FINGER_NAMES[0]], links[FINGER_NAMES[1]]),
         joints=joints,
         close_target_m=-max(
             cfg.close_past_m, cfg.close_force_margin * float(cfg.grip_force_n) / cfg.finger_stiffness_n_per_m

@@ -2,7 +2,7 @@
 remove the box and hold (collab) or pull back and lift (bin). Staged checks stop at the first failure.
 
 The trial knows nothing of how a grasp is planned or scored: the caller passes the planner and the quality
-check (:class:`TrialContext` ``plan`` and ``quality``), and the log it writes to (:class:`TrialLog`).
+check (:class:`TrialContext` ``plan`` and ``quality``), and the log it writes to (:class:`LogSink`).
 """
 
 import dataclasses
@@ -18,16 +18,17 @@ import trimesh
 from omegaconf import DictConfig, OmegaConf
 
 from graspexp.config import JobConfig
+from graspexp.core.bodies import FINGER_NAMES, SUPPORT_NAME
+from graspexp.core.geometry import make_pose, random_rotation, transform_points, yaw_rotation
+from graspexp.core.outcome import FailureReason, TrialResult
+from graspexp.core.seeding import plan_seed, rng_for
 from graspexp.datasets.model import ObjectModel
-from graspexp.geometry import make_pose, random_rotation, transform_points, yaw_rotation
-from graspexp.outcome import FailureReason, TrialResult
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.request import PlanRequest, PlanResult
 from graspexp.planning.stability import pose_error
-from graspexp.seeding import plan_seed, rng_for
 from graspexp.sim.contacts import SupportTouch, contact_records, finger_forces
-from graspexp.sim.gripper import FINGER_NAMES, Gripper, build_gripper
-from graspexp.sim.scene import SUPPORT_NAME, TrialScene, build_scene
+from graspexp.sim.gripper import Gripper, build_gripper
+from graspexp.sim.scene import TrialScene, build_scene
 
 
 class TrialFailed(Exception):
@@ -38,7 +39,7 @@ class TrialFailed(Exception):
         self.reason = reason
 
 
-class TrialLog(Protocol):
+class LogSink(Protocol):
     """What a trial writes to its log (:class:`graspexp.record.TrialWriter` is one); times ``t_s`` are sim
     time, s. ``active`` False: the trial skips gathering the per-step messages (transforms, contacts)."""
 
@@ -56,7 +57,7 @@ class TrialLog(Protocol):
 
 
 class NullRecorder:
-    """The :class:`TrialLog` of a trial that is not logged: every message is dropped. Subclasses that keep
+    """The :class:`LogSink` of a trial that is not logged: every message is dropped. Subclasses that keep
     some messages set ``active = True``, so the trial gathers them."""
 
     active = False
@@ -100,7 +101,7 @@ class TrialContext:
     hulls: list[np.ndarray]
     trial: int
     trial_seed: int
-    recorder: TrialLog = field(default_factory=NullRecorder)
+    recorder: LogSink = field(default_factory=NullRecorder)
     scene: object | None = None
     """The object's Foxglove scene for the log (:func:`graspexp.record.object_scene`, built once per object);
     None: no /scene messages."""
@@ -148,7 +149,7 @@ class _Sim:
     two dot products) and, while :meth:`watch_support` is on, the gripper-support contact check.
     """
 
-    def __init__(self, ts: TrialScene, cfg: JobConfig, recorder: TrialLog, timings: dict[str, float]):
+    def __init__(self, ts: TrialScene, cfg: JobConfig, recorder: LogSink, timings: dict[str, float]):
         self.ts, self.cfg, self.rec, self.timings = ts, cfg, recorder, timings
         self.dt = float(cfg.sim.timestep_s)
         self.t, self.steps = 0.0, 0

@@ -66,7 +66,7 @@ class OptimalPlusConfig(PaperPathsConfig, AreaContactConfig):
     paper's cost already ranks the paths the shortlist is drawn from. Within it the failures held in
     simulation were grasps a finger's side or tip face met, not its pad (power drill, mug: one pad at
     35-40 N, the other finger's side face at 40-46 N): of 4983 shortlisted grasps simulated one by one
-    on the same drops (``python -m graspexp.bench.shortlist --trials 5``, every Table 1/2 object and
+    on the same drops (``python -m graspexp bench.shortlist --trials 5``, every Table 1/2 object and
     setting), 1313 of 1314 with the object nowhere past a pad's plane by the finger edges were held,
     against 93 % (292 of 314) where it reached 2 mm or more past it (README, "optimal_plus")."""
     edge_clearance_m: float = 0.002

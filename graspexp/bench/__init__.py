@@ -1,1 +1,0 @@
-"""Benchmarks run by ``nox -s bench`` (``python -m graspexp.bench.<name>``)."""

@@ -1,0 +1,73 @@
+"""One object standing upright on the support, planned once: what ``graspexp.tools.plan``, ``graspexp.tools.figures``
+and the planner bench show (no simulation; the object is not dropped).
+
+The pose is the identity rotation translated so that the mesh's lowest point sits on
+``z = mode.support_height_m`` (x = y = 0). The plan's seed is the runner's for trial
+:data:`UPRIGHT_TRIAL` (:func:`graspexp.core.seeding.plan_seed`).
+"""
+
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from omegaconf import OmegaConf
+
+from graspexp.core.seeding import plan_seed, trial_seed
+from graspexp.datasets import ObjectModel
+from graspexp.planning.registry import plan
+from graspexp.planning.request import PlanRequest, PlanResult
+
+UPRIGHT_TRIAL = 0
+"""The trial index whose planner seed an upright plan uses."""
+
+
+@dataclass(frozen=True)
+class PlannedObject:
+    """One object placed upright on the support and its plan."""
+
+    model: ObjectModel
+    """Object frame."""
+    object_pose: np.ndarray
+    """(4,4) world pose of the object frame."""
+    request: PlanRequest
+    result: PlanResult
+    plan_ms: float
+    """Wall time of the planner call, ms."""
+
+
+def upright_pose(model: ObjectModel, support_height_m: float) -> np.ndarray:
+    """(4,4) identity rotation, translated so the mesh's lowest point is on ``z = support_height_m`` (m)."""
+    pose = np.eye(4)
+    pose[2, 3] = support_height_m - float(np.min(model.mesh.vertices[:, 2]))
+    return pose
+
+
+def upright_request(cfg: Any, model: ObjectModel) -> PlanRequest:
+    """The planning request for ``model`` standing upright on the support of job config ``cfg``."""
+    pose = upright_pose(model, float(cfg.mode.support_height_m))
+    return PlanRequest(
+        points=model.points @ pose[:3, :3].T + pose[:3, 3],
+        normals=model.normals @ pose[:3, :3].T,
+        area_mask=np.asarray(model.area_mask, dtype=bool),
+        object_pose=pose,
+        table_z=float(cfg.mode.support_height_m),
+        mode=str(cfg.mode.name),
+        gripper=OmegaConf.to_object(cfg.gripper),
+        planner=OmegaConf.to_object(cfg.planner),
+        cost=OmegaConf.to_object(cfg.cost),
+        seed=plan_seed(trial_seed(cfg, model.name, UPRIGHT_TRIAL)),
+        support_blocks_gripper=bool(cfg.mode.support_collides_with_gripper),
+    )
+
+
+def plan_upright(cfg: Any, model: ObjectModel) -> PlannedObject:
+    """Place ``model`` upright on the support and plan with the configured planner (raises
+    :class:`~graspexp.planning.NoFeasibleGrasp` or :class:`~graspexp.planning.UnknownPlanner`)."""
+    req = upright_request(cfg, model)
+    start = time.perf_counter()
+    result = plan(req)
+    plan_ms = (time.perf_counter() - start) * 1e3
+    return PlannedObject(
+        model=model, object_pose=req.object_pose, request=req, result=result, plan_ms=plan_ms
+    )

@@ -1,0 +1,189 @@
+"""Shortlist study: every grasp ``optimal_plus`` shortlists, simulated one at a time on the same drop,
+beside what the planner measured of it.
+
+    python -m graspexp bench.shortlist [--out shortlist.csv] [--trials 5] [--settings collab/z,bin/xyz]
+        [--datasets ycb,linemod] [--objects a,b] [--workers 2] [key=value ...]
+
+For each dataset, setting, object and trial the planner runs once; each of its S shortlisted paths
+(``details["shortlist_*"]``, graspexp/planning/optimal_plus.py) is then executed in a fresh trial on the
+same drop by a planner that returns that grasp. One CSV row per simulated grasp: held or not, the failure
+reason, the edge excess (how far the object reaches past a pad's contact plane by the finger edges, the
+measure ``choose_by=edge_clearance`` minimises), the pad depth, whether it passed the noise check, and
+which grasp each ``choose_by`` rule picks. Prints the share held per band of edge excess and how often each
+rule's pick is held. ``key=value`` arguments are job overrides (``planner.*``, ``sim.*``, ...).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import sys
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from threadpoolctl import threadpool_limits
+
+from graspexp.config.compose import compose_config
+from graspexp.core.seeding import trial_seed
+from graspexp.datasets import available_objects, job_object
+from graspexp.planning import plan
+from graspexp.planning.optimal_plus import pick_shortlisted
+from graspexp.planning.request import PlanResult
+from graspexp.quality import fc_min_mu
+from graspexp.report.paper import SETTINGS
+from graspexp.sim.collision_shapes import collision_shape
+from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
+from graspexp.tools.cli import compose_checked, fail, tool_parser
+
+PROG = "graspexp bench.shortlist"
+RULES = ("edge_clearance", "cost")
+"""The ``planner.choose_by`` rules whose picks are scored from the simulated shortlist."""
+EXCESS_BANDS_MM = (-np.inf, 0.0, 0.5, 1.0, 2.0, 4.0, np.inf)
+"""Bands of edge excess (mm) the printed table splits the grasps into."""
+
+
+def _forced(j: int, seen: dict):
+    """A planner that returns ``optimal_plus``'s ``j``-th shortlisted grasp. The drop, so the request, is
+    the same in every trial of one drop: the plan is made in the first and kept in ``seen["plan"]``."""
+
+    def planner(req):
+        res = seen.get("plan") or seen.setdefault("plan", plan(req))
+        d = res.details
+        grasp = dataclasses.replace(
+            res.grasp, pose=d["shortlist_poses"][j], width_m=float(d["shortlist_widths"][j])
+        )
+        return PlanResult(grasp=grasp, details=d)
+
+    return planner
+
+
+def _job(args: tuple[list[str], str, int]) -> list[dict]:
+    """Every shortlisted grasp of ``trials`` drops of one object in one job config (a worker's task)."""
+    overrides, name, trials = args
+    threadpool_limits(limits=1)
+    cfg = compose_config(overrides)
+    plain = plain_config(cfg)
+    model = job_object(cfg, name)
+    hulls = collision_shape(model.mesh, plain.sim)
+    rows = []
+    for i in range(trials):
+        seed = trial_seed(plain, name, i)
+        seen: dict = {}
+        j, n = 0, 1
+        while j < n:
+            ctx = TrialContext(
+                plain, model, hulls, i, seed, NullRecorder(), plan=_forced(j, seen), quality=fc_min_mu
+            )
+            res = run_trial(ctx)
+            if "plan" not in seen:  # no grasp planned for this drop: nothing to compare
+                break
+            d = seen["plan"].details
+            n = len(d["shortlist_costs"])
+            rows.append(
+                {
+                    "object": name,
+                    "trial": i,
+                    "candidate": j,
+                    "held": res.success,
+                    "reason": res.reason or "",
+                    "edge_excess_mm": 1000 * float(d["shortlist_edge_excess_m"][j]),
+                    "pad_depth_mm": 1000 * float(d["shortlist_pad_depth_m"][j]),
+                    "robust": bool(d["shortlist_robust"][j]),
+                    "cost": float(d["shortlist_costs"][j]),
+                    **{
+                        f"pick_{rule}": j
+                        == pick_shortlisted(
+                            rule, d["shortlist_costs"], d["shortlist_robust"], d["shortlist_edge_excess_m"]
+                        )
+                        for rule in RULES
+                    },
+                }
+            )
+            j += 1
+    return rows
+
+
+def study(
+    overrides: list[str],
+    datasets: list[str],
+    settings: list[str],
+    objects: list[str],
+    trials: int,
+    workers: int,
+) -> pd.DataFrame:
+    """One row per simulated shortlisted grasp (module doc), every dataset x setting x object."""
+    jobs = []
+    for dataset in datasets:
+        for setting in settings:
+            mode, rot = setting.split("/")
+            job = [f"dataset={dataset}", f"mode={mode}", f"rot={rot}", "planner=optimal_plus", *overrides]
+            cfg = compose_checked(job, PROG)
+            names = objects or available_objects(cfg.dataset)
+            jobs += [((job, n, trials), dataset, setting) for n in names]
+    frames = []
+    with ProcessPoolExecutor(workers) as pool:
+        for (_, dataset, setting), rows in zip(jobs, pool.map(_job, [j for j, _, _ in jobs]), strict=True):
+            print(f"{dataset} {setting} {rows[0]['object'] if rows else ''}: {len(rows)} grasps", flush=True)
+            frames.append(pd.DataFrame(rows).assign(dataset=dataset, setting=setting))
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+
+
+def summary(df: pd.DataFrame) -> str:
+    """Held % (grasps) per band of edge excess and per rule's pick, per dataset, as Markdown."""
+    edges = EXCESS_BANDS_MM
+    labels = (
+        [f"<= {edges[1]:g}"]
+        + [f"{a:g} - {b:g}" for a, b in zip(edges[1:-2], edges[2:-1], strict=True)]
+        + [f"> {edges[-2]:g}"]
+    )
+    band = pd.cut(df["edge_excess_mm"], edges, labels=labels)
+    held = df.groupby([band, "dataset"], observed=True)["held"]
+    table = (100 * held.mean()).round(1).astype(str) + " % (" + held.size().astype(str) + ")"
+    picks = {
+        rule: df[df[f"pick_{rule}"]].groupby("dataset")["held"].agg(lambda h: f"{int(h.sum())} / {len(h)}")
+        for rule in RULES
+    }
+    return (
+        "Shortlisted grasps held, % (grasps), by edge excess (mm):\n\n"
+        + table.unstack("dataset").fillna("").to_markdown()
+        + "\n\nDrops whose pick is held, per planner.choose_by rule:\n\n"
+        + pd.DataFrame(picks).to_markdown()
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = tool_parser(PROG, __doc__, overrides=True)
+    ap.add_argument(
+        "--out", type=Path, default=Path("shortlist.csv"), help="CSV written (default shortlist.csv)"
+    )
+    ap.add_argument("--trials", type=int, default=5, help="drops per object and setting (default 5)")
+    ap.add_argument(
+        "--settings", default=",".join("/".join(s) for s in SETTINGS), help="comma-separated mode/rot"
+    )
+    ap.add_argument("--datasets", default="ycb,linemod", help="comma-separated datasets")
+    ap.add_argument("--objects", default="", help="comma-separated object names (default: every staged one)")
+    ap.add_argument("--workers", type=int, default=2, help="processes (default 2)")
+    args = ap.parse_intermixed_args(argv)
+    settings = [s for s in args.settings.split(",") if s]
+    for s in settings:
+        if s.count("/") != 1:
+            fail(f"--settings entry {s!r} is invalid: expected mode/rot, e.g. collab/z", PROG)
+    df = study(
+        list(args.overrides),
+        [d for d in args.datasets.split(",") if d],
+        settings,
+        [o for o in args.objects.split(",") if o],
+        args.trials,
+        args.workers,
+    )
+    if df.empty:
+        fail("no grasp was planned: nothing to simulate", PROG)
+    df.to_csv(args.out, index=False)
+    print(summary(df))
+    print(f"{PROG}: {len(df)} grasps in {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,406 @@
+"""``python -m graspexp benchmark [--option ...] planner=NAME [dataset=...] [key=value ...]``: the standard
+suite for any installed planner, ranked beside the built-in planners and the paper's published numbers.
+
+The standard suite: the paper's four settings (collab / bin x rotation z / xyz) on Table 1 (``ycb``) and
+Table 2 (``linemod``), :data:`graspexp.report.paper.TRIALS_PER_SETTING` trials per object, at zero pose
+noise and at each of :data:`NOISE_LEVELS`. Every planner runs the same drops (a drop depends only on the
+seed, dataset, object and trial index).
+
+``key=value`` arguments are job overrides, as for every tool: ``planner=NAME`` (required) is the planner
+entered; ``dataset=`` one dataset or several (``dataset=ycb,linemod``, the default); ``trials=``;
+``objects=[...]`` a subset; ``planner.*`` keys go to the entered planner only, the rest (``gripper=``,
+``sim.*``, ...) to every planner. Options:
+
+- ``--settings collab/z,bin/xyz``: the settings (default the four);
+- ``--noise 10:0,0:10``: pose-noise levels ``trans_mm:rot_deg`` besides zero (``--noise ''``: none);
+- ``--compare obb,random``: planners ranked beside it (default the built-in ones; they run too where
+  their results are missing, once, and are reused by every later entrant);
+- ``--out DIR`` (default ``outputs/benchmark``); ``--n-jobs N`` (default 2): jobs in parallel with joblib;
+- ``--launcher submitit``: one SLURM array task per job through submitit (``--slurm-partition``,
+  ``--timeout-min``; where no SLURM exists submitit runs them as local processes).
+
+Output, one folder per planner, ``OUT/<planner>/``: ``runs/<dataset>/<mode>_<rot>_t<mm>_r<deg>/`` (the
+runner's job directories: resumable, locked, one MCAP log per trial), ``summary.md`` (ranking and tables),
+``ranking.csv``, ``trials.csv`` (per trial: outcome and in-area contact fraction), ``noise.csv``,
+``failures.csv`` and ``reproduce.json`` (command, every job's composed
+config, package versions, planner package and version). Re-running the same command resumes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+import yaml
+from omegaconf import OmegaConf
+
+from graspexp.config import ConfigError, PluginError
+from graspexp.config.compose import compose_config
+from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
+from graspexp.report.collect import collect
+from graspexp.report.compare import FC_MU, check_same_drops, render_markdown
+from graspexp.report.compare import success_by_noise as noise_success_table
+from graspexp.report.contact_area import IN_AREA_TOLERANCE_M, finger_contacts_in_area
+from graspexp.report.paper import PAPER_TABLES, SETTINGS, TRIALS_PER_SETTING
+from graspexp.report.render import display_frame, footnotes, markdown
+from graspexp.report.stats import percentiles, success_pct
+from graspexp.report.tables import failure_breakdown, success_table
+from graspexp.tools.cli import compose_checked, fail, tool_parser
+
+TRIAL_COLUMNS = (
+    "planner",
+    "dataset",
+    "mode",
+    "rot",
+    "trans_mm",
+    "rot_deg",
+    "object",
+    "trial",
+    "success",
+    "reason",
+    "contacts",
+    "contacts_in_area",
+    "fc_min_mu",
+    "plan_ms",
+)
+"""Columns of ``trials.csv``: one row per trial, with its in-area contact fraction beside its outcome."""
+NOISE_LEVELS: tuple[tuple[float, float], ...] = ((10.0, 0.0), (20.0, 0.0), (0.0, 10.0))
+"""Pose-noise levels (translation std mm, rotation std degrees) run besides zero, as in ``nox -s compare``."""
+IN_AREA_NOTE = (
+    "In-area contact %: share of the finger-object contacts at the end of closing that lie within "
+    f"{IN_AREA_TOLERANCE_M * 1000:g} mm of a grasping-area point of the object's reference cloud "
+    "(graspexp/report/contact_area.py; from each log's /contacts and /tf), over the trials whose fingers "
+    "touch the object then. Trials all in area %: share of those trials whose every contact is in the area. "
+    "Success in area: successful trials whose every contact is in the area (the hand-over task's success)."
+)
+
+
+@dataclass
+class Benchmark:
+    """What one ``python -m graspexp benchmark`` command runs (see the module doc)."""
+
+    planner: str
+    datasets: list[str] = field(default_factory=lambda: list(PAPER_TABLES))
+    settings: list[str] = field(default_factory=lambda: [f"{m}/{r}" for m, r in SETTINGS])
+    trials: int = TRIALS_PER_SETTING
+    objects: list[str] | None = None
+    noise: list[list[float]] = field(default_factory=lambda: [list(n) for n in NOISE_LEVELS])
+    compare: list[str] | None = None
+    out: str = "outputs/benchmark"
+    n_jobs: int = 2
+    launcher: str = "joblib"
+    slurm_partition: str = ""
+    timeout_min: int = 240
+    overrides: list[str] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class Job:
+    planner: str
+    dataset: str
+    mode: str
+    rot: str
+    trans_mm: float
+    rot_deg: float
+    overrides: tuple[str, ...]
+    run_dir: str
+
+
+PROG = "graspexp benchmark"
+SUITE_KEYS = ("planner", "dataset", "trials", "objects")
+"""Job keys whose values choose the suite (the other overrides are passed on to every job)."""
+
+
+def _names(text: str) -> list[str]:
+    """``a,b`` or ``[a,b]`` -> ``["a", "b"]``."""
+    return [t.strip() for t in text.strip().strip("[]").split(",") if t.strip()]
+
+
+def _noise_levels(text: str) -> list[list[float]]:
+    """``10:0,0:10`` -> ``[[10.0, 0.0], [0.0, 10.0]]``; ``''`` -> ``[]``."""
+    try:
+        return [[float(v) for v in level.split(":")] for level in _names(text)]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: expected trans_mm:rot_deg levels, e.g. 10:0,0:10"
+        ) from None
+
+
+def arg_parser() -> argparse.ArgumentParser:
+    """The benchmark's command line (module doc)."""
+    parser = tool_parser(PROG, __doc__, overrides=True)
+    parser.add_argument("--settings", type=_names, help="comma-separated mode/rot (default: the four)")
+    parser.add_argument("--noise", type=_noise_levels, help="trans_mm:rot_deg levels besides zero")
+    parser.add_argument(
+        "--compare", type=_names, help="planners ranked beside it (default: the built-in ones)"
+    )
+    parser.add_argument("--out", default=Benchmark.out, help=f"output folder (default {Benchmark.out})")
+    parser.add_argument("--n-jobs", type=int, default=Benchmark.n_jobs, help="jobs in parallel (joblib)")
+    parser.add_argument("--launcher", choices=("joblib", "submitit"), default=Benchmark.launcher)
+    parser.add_argument("--slurm-partition", default=Benchmark.slurm_partition, help="with submitit")
+    parser.add_argument("--timeout-min", type=int, default=Benchmark.timeout_min, help="with submitit")
+    return parser
+
+
+def parse_args(argv: list[str]) -> Benchmark:
+    """The command line (module doc) -> :class:`Benchmark`."""
+    args = arg_parser().parse_intermixed_args(argv)
+    values: dict = {"overrides": []}
+    for tok in args.overrides:
+        key, sep, raw = tok.partition("=")
+        if key not in SUITE_KEYS or not sep:
+            values["overrides"].append(tok)
+        elif key == "dataset":
+            values["datasets"] = _names(raw)
+        else:
+            values[key] = yaml.safe_load(raw) if key != "planner" else raw
+    if "planner" not in values:
+        raise ConfigError("planner is missing: python -m graspexp benchmark planner=NAME [dataset=...]")
+    options = ("settings", "noise", "compare", "out", "n_jobs", "launcher", "slurm_partition", "timeout_min")
+    bench = Benchmark(**values, **{k: getattr(args, k) for k in options if getattr(args, k) is not None})
+    for s in bench.settings:
+        if s.count("/") != 1:
+            raise ConfigError(f"--settings entry {s!r} is invalid: expected mode/rot, e.g. collab/z")
+    return bench
+
+
+def compared(bench: Benchmark) -> list[str]:
+    """The planners ranked beside the entered one: ``compare`` or every built-in planner."""
+    if bench.compare is not None:
+        return [p for p in bench.compare if p != bench.planner]
+    builtin = [
+        n
+        for n, p in load_planners().items()
+        if isinstance(p, LoadedPlanner) and p.package.startswith("graspexp ")
+    ]
+    return [n for n in builtin if n != bench.planner]
+
+
+def jobs(bench: Benchmark) -> list[Job]:
+    """Every (planner, dataset, setting, noise level) job of the suite, entered planner first."""
+    shared = [o for o in bench.overrides if not o.lstrip("+~").startswith("planner.")]
+    own = [o for o in bench.overrides if o.lstrip("+~").startswith("planner.")]
+    levels = [(0.0, 0.0)] + [(float(t), float(r)) for t, r in bench.noise if (t, r) != (0, 0)]
+    objects = [f"objects=[{','.join(bench.objects)}]"] if bench.objects else []
+    out = []
+    for planner in [bench.planner, *compared(bench)]:
+        for dataset in bench.datasets:
+            for setting in bench.settings:
+                mode, rot = setting.split("/")
+                for t, r in levels:
+                    overrides = (
+                        f"planner={planner}",
+                        f"dataset={dataset}",
+                        f"mode={mode}",
+                        f"rot={rot}",
+                        f"perception.noise.trans_mm={t}",
+                        f"perception.noise.rot_deg={r}",
+                        f"trials={bench.trials}",
+                        "progress=false",
+                        *objects,
+                        *shared,
+                        *(own if planner == bench.planner else []),
+                    )
+                    run_dir = Path(bench.out) / planner / "runs" / dataset / f"{mode}_{rot}_t{t:g}_r{r:g}"
+                    out.append(Job(planner, dataset, mode, rot, t, r, overrides, str(run_dir)))
+    return out
+
+
+def run_one(job: Job) -> str:
+    """Run (or resume) one job; '' on success, else the one-line reason."""
+    from graspexp.run.runner import run_in_dir
+
+    try:
+        run_in_dir(compose_config(list(job.overrides)), Path(job.run_dir))
+    except Exception as exc:  # one job's failure is reported; the others run
+        return f"{job.run_dir}: {type(exc).__name__}: {exc}"
+    return ""
+
+
+def run_all(bench: Benchmark, todo: list[Job]) -> list[str]:
+    """Run the jobs (joblib processes, or submitit / SLURM); the error line of each failed job."""
+    if bench.launcher == "submitit":
+        import submitit
+
+        executor = submitit.AutoExecutor(folder=Path(bench.out) / "submitit")
+        params = {"timeout_min": bench.timeout_min, "cpus_per_task": 1}
+        if bench.slurm_partition:
+            params["slurm_partition"] = bench.slurm_partition
+        executor.update_parameters(**params)
+        return [e for e in (j.result() for j in executor.map_array(run_one, todo)) if e]
+    from joblib import Parallel, delayed
+
+    return [e for e in Parallel(n_jobs=bench.n_jobs)(delayed(run_one)(j) for j in todo) if e]
+
+
+def results(all_jobs: list[Job]) -> pd.DataFrame:
+    """One row per readable trial log of every job: report.collect columns plus trans_mm, rot_deg and the
+    finger-object contacts at the end of closing (``contacts``) and how many lie in the grasping area
+    (``contacts_in_area``)."""
+    frames = []
+    for job in all_jobs:
+        if Path(job.run_dir).is_dir():
+            df = collect(job.run_dir).results
+            if not df.empty:
+                counts = [finger_contacts_in_area(p) for p in df["path"]]
+                df = df.assign(
+                    trans_mm=job.trans_mm,
+                    rot_deg=job.rot_deg,
+                    contacts_in_area=[c[0] for c in counts],
+                    contacts=[c[1] for c in counts],
+                )
+                frames.append(df)
+    return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
+
+
+def _success(g: pd.DataFrame) -> str:
+    n = len(g)
+    rate, lo, hi = success_pct(int(g["success"].sum()), n)
+    return f"{rate:.0f} [{lo:.0f}, {hi:.0f}] ({n})" if n else "n/a"
+
+
+def ranking(df: pd.DataFrame, dataset: str, settings: list[str]) -> pd.DataFrame:
+    """Zero-noise trials of one dataset: one row per planner, best success first, then the paper's
+    printed Average of its own method (where the paper reports this dataset)."""
+    rows = []
+    zero = df[(df["dataset"] == dataset) & (df["trans_mm"] == 0) & (df["rot_deg"] == 0)]
+    for planner, g in zero.groupby("planner", sort=True):
+        row = {"planner": planner, "success % [95% CI] (n)": _success(g), "_rate": g["success"].mean()}
+        for s in settings:
+            mode, rot = s.split("/")
+            row[s] = _success(g[(g["mode"] == mode) & (g["rot"] == rot)])
+        planned = g[g["reason"] != "no_feasible_grasp"]
+        touched = int(g["contacts"].sum())
+        row["in-area contact %"] = f"{100 * g['contacts_in_area'].sum() / touched:.0f}" if touched else "n/a"
+        held = g[g["contacts"] > 0]
+        all_in = (held["contacts_in_area"] == held["contacts"]).mean() if len(held) else math.nan
+        row["trials all in area %"] = f"{100 * all_in:.0f}" if len(held) else "n/a"
+        in_area_success = g["success"] & (g["contacts"] > 0) & (g["contacts_in_area"] == g["contacts"])
+        row["success in area % [95% CI]"] = _success(g.assign(success=in_area_success))
+        row[f"force-closure % (mu<={FC_MU:g})"] = (
+            f"{100 * (planned['fc_min_mu'] <= FC_MU + 1e-9).mean():.0f}" if len(planned) else "n/a"
+        )
+        mu = planned["fc_min_mu"].median() if len(planned) else math.nan
+        row["median min mu"] = f"{mu:.2f}"
+        p50, p95 = percentiles(g["plan_ms"])
+        row["plan ms p50 / p95"] = f"{p50:.0f} / {p95:.0f}"
+        reasons = g.loc[~g["success"], "reason"].fillna("(none)").value_counts()
+        row["failures"] = ", ".join(f"{r} {c}" for r, c in reasons.head(3).items()) or "none"
+        rows.append(row)
+    table = pd.DataFrame(rows)
+    if not table.empty:
+        table = table.sort_values(["_rate", "planner"], ascending=[False, True]).drop(columns="_rate")
+    paper = PAPER_TABLES.get(dataset)
+    if paper is not None:
+        printed = dict(zip([f"{m}/{r}" for m, r in SETTINGS], paper.ours_average, strict=True))
+        shown = [printed[s] for s in settings if s in printed]
+        row = {"planner": "paper (printed Average, its own method)"}
+        row["success % [95% CI] (n)"] = f"{sum(shown) / len(shown):.0f}" if shown else "n/a"
+        row.update({s: f"{printed[s]:.0f}" if s in printed else "n/a" for s in settings})
+        table = pd.concat([table, pd.DataFrame([row])], ignore_index=True).fillna("")
+    return table
+
+
+def reproduce_record(bench: Benchmark, all_jobs: list[Job], configs: list[dict], argv: list[str]) -> dict:
+    """Everything needed to re-run the suite: command, benchmark keys, each job's composed config
+    (``configs``, in job order), package versions, and each planner's package, entry point and version."""
+    from graspexp.run.runner import package_versions
+
+    planners = {}
+    for name in dict.fromkeys(j.planner for j in all_jobs):
+        p = get_plugin(name)
+        planners[name] = {"package": p.package, "entry_point": p.entry_point, "version": p.version}
+    return {
+        "command": "python -m graspexp benchmark " + " ".join(argv),
+        "benchmark": dataclasses.asdict(bench),
+        "packages": package_versions(),
+        "planners": planners,
+        "jobs": [
+            {
+                **{k: v for k, v in dataclasses.asdict(j).items() if k != "overrides"},
+                "overrides": list(j.overrides),
+                "config": c,
+            }
+            for j, c in zip(all_jobs, configs, strict=True)
+        ],
+    }
+
+
+def write_summary(
+    bench: Benchmark, all_jobs: list[Job], configs: list[dict], errors: list[str], argv: list[str]
+) -> str:
+    """Write the result folder ``OUT/<planner>/`` (module doc); returns the Markdown summary."""
+    out = Path(bench.out) / bench.planner
+    out.mkdir(parents=True, exist_ok=True)
+    df = results(all_jobs)
+    lines = [f"# Benchmark: planner `{bench.planner}`", ""]
+    if df.empty:
+        lines.append("No readable trial logs.")
+    else:
+        df = df[df["planner"].isin([bench.planner, *compared(bench)])]
+        rankings = []
+        for dataset in bench.datasets:
+            table = ranking(df, dataset, bench.settings)
+            rankings.append(table.assign(dataset=dataset))
+            lines += [f"## Ranking on `{dataset}` (zero pose noise)", "", markdown(table, index=False), ""]
+        lines += [
+            "Success: successes / trials with the Wilson 95 % score interval; plan time: wall time of the "
+            f"plan call (ms); force-closure: share of planned grasps force-closure at mu <= {FC_MU:g}, and "
+            "the median smallest such mu (NaN: none); failures: the three most frequent reasons.",
+            IN_AREA_NOTE,
+            "",
+        ]
+        pd.concat(rankings).to_csv(out / "ranking.csv", index=False)
+        per_trial = df[[*TRIAL_COLUMNS]].assign(
+            in_area_fraction=(df["contacts_in_area"] / df["contacts"].where(df["contacts"] > 0))
+        )
+        per_trial.to_csv(out / "trials.csv", index=False)
+        zero = df[(df["trans_mm"] == 0) & (df["rot_deg"] == 0)]
+        for dataset in bench.datasets:
+            if dataset in PAPER_TABLES and (zero["dataset"] == dataset).any():
+                st = success_table(zero, dataset, bench.planner)
+                lines += [f"## `{bench.planner}` beside the paper's Table {st.paper.number}", ""]
+                lines += [markdown(display_frame(st)), "", *(f"- {n}" for n in footnotes(st)), ""]
+        noise = noise_success_table(df)
+        noise.to_csv(out / "noise.csv", index=False)
+        lines += ["## Every setting and pose-noise level", ""]
+        lines += render_markdown(noise, check_same_drops(df), []).splitlines()[2:]
+        failures = failure_breakdown(zero)
+        failures.to_csv(out / "failures.csv", index=False)
+        lines += ["", "## Failure reasons (zero pose noise)", "", markdown(failures, index=False), ""]
+    if errors:
+        lines += ["## Jobs that did not finish", "", *(f"- {e}" for e in errors), ""]
+    text = "\n".join(lines) + "\n"
+    (out / "summary.md").write_text(text)
+    (out / "reproduce.json").write_text(
+        json.dumps(reproduce_record(bench, all_jobs, configs, argv), indent=1)
+    )
+    return text
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    try:
+        bench = parse_args(argv)
+        get_plugin(bench.planner)
+    except (ConfigError, PluginError) as exc:
+        fail(str(exc), PROG)
+    all_jobs = jobs(bench)
+    # every job's config is checked before the first trial runs
+    configs = [OmegaConf.to_container(compose_checked(j.overrides, PROG), resolve=True) for j in all_jobs]
+    errors = run_all(bench, all_jobs)
+    print(write_summary(bench, all_jobs, configs, errors, argv), end="")
+    print(f"graspexp benchmark: results in {Path(bench.out) / bench.planner}", file=sys.stderr)
+    for e in errors:
+        print(f"graspexp benchmark: job failed: {e}", file=sys.stderr)
+    return 1 if errors else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

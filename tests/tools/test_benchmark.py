@@ -1,0 +1,78 @@
+"""The benchmark command's suite, arguments and ranking (no physics: the end-to-end run is in test_plugin)."""
+
+import pandas as pd
+import pytest
+
+from graspexp.config import ConfigError
+from graspexp.report.paper import PAPER_TABLES, SETTINGS
+from graspexp.tools.benchmark import NOISE_LEVELS, compared, jobs, parse_args, ranking
+
+
+def test_standard_suite_is_four_settings_on_both_tables_at_every_noise_level_for_every_planner():
+    bench = parse_args(["planner=obb", "planner.width_clearance_m=0.01", "gripper=panda"])
+    assert bench.datasets == ["ycb", "linemod"] and bench.trials == 10
+    others = compared(bench)
+    assert "obb" not in others and {
+        "optimal",
+        "optimal_literal",
+        "optimal_plus",
+        "antipodal",
+        "random",
+    } <= set(others)
+    todo = jobs(bench)
+    assert len(todo) == (1 + len(others)) * 2 * len(SETTINGS) * (1 + len(NOISE_LEVELS))
+    assert len({j.run_dir for j in todo}) == len(todo)
+    for j in todo:  # planner keys go to the entered planner only, the rest to every planner
+        assert ("planner.width_clearance_m=0.01" in j.overrides) == (j.planner == "obb")
+        assert "gripper=panda" in j.overrides and "trials=10" in j.overrides
+
+
+def test_bad_arguments_are_one_clear_error():
+    with pytest.raises(ConfigError, match="planner is missing"):
+        parse_args(["dataset=ycb"])
+    with pytest.raises(ConfigError, match="--settings entry 'collab' is invalid: expected mode/rot"):
+        parse_args(["planner=obb", "--settings", "collab"])
+    with pytest.raises(SystemExit):  # argparse: usage and "invalid choice: 'pbs'"
+        parse_args(["planner=obb", "--launcher", "pbs"])
+
+
+def test_options_and_suite_keys_are_read_and_the_rest_goes_to_the_jobs():
+    bench = parse_args(
+        [
+            "--settings",
+            "collab/z",
+            "--noise",
+            "5:0,0:5",
+            "--compare",
+            "obb",
+            "--n-jobs",
+            "1",
+            "planner=random",
+        ]
+        + ["dataset=ycb,primitives", "trials=3", "objects=[can,box]", "sim.close_s=0.5"]
+    )
+    assert (bench.planner, bench.datasets, bench.trials, bench.objects) == (
+        "random",
+        ["ycb", "primitives"],
+        3,
+        ["can", "box"],
+    )
+    assert bench.settings == ["collab/z"] and bench.noise == [[5.0, 0.0], [0.0, 5.0]]
+    assert bench.compare == ["obb"] and bench.n_jobs == 1 and bench.overrides == ["sim.close_s=0.5"]
+    assert parse_args(["planner=obb", "--noise", ""]).noise == []
+
+
+def test_ranking_puts_the_best_first_and_the_paper_printed_average_last():
+    rows = []
+    for planner, successes in (("a", [True, False]), ("b", [True, True])):
+        for i, ok in enumerate(successes):
+            rows.append(
+                dict(dataset="ycb", planner=planner, mode="collab", rot="z", object="025_mug", trial=i, success=ok,
+                     reason=None if ok else "dropped", fc_min_mu=0.4, plan_ms=10.0 + i, trans_mm=0.0, rot_deg=0.0,
+                     contacts=2, contacts_in_area=1)
+            )  # fmt: skip
+    table = ranking(pd.DataFrame(rows), "ycb", ["collab/z"])
+    assert list(table["planner"][:2]) == ["b", "a"]
+    assert table["collab/z"].iloc[1] == "50 [9, 91] (2)"
+    assert table["in-area contact %"].iloc[0] == "50" and table["failures"].iloc[1] == "dropped 1"
+    assert table["collab/z"].iloc[2] == f"{PAPER_TABLES['ycb'].ours_average[0]:.0f}"
