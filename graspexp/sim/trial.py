@@ -149,10 +149,20 @@ class _Sim:
     two dot products) and, while :meth:`watch_support` is on, the gripper-support contact check.
     """
 
-    def __init__(self, ts: TrialScene, cfg: JobConfig, recorder: LogSink, timings: dict[str, float]):
+    def __init__(
+        self,
+        ts: TrialScene,
+        cfg: JobConfig,
+        recorder: LogSink,
+        timings: dict[str, float],
+        log_offset_s: float = 0.0,
+    ):
         self.ts, self.cfg, self.rec, self.timings = ts, cfg, recorder, timings
         self.dt = float(cfg.sim.timestep_s)
         self.t, self.steps = 0.0, 0
+        self.log_offset_s = log_offset_s
+        """Added to the sim time of everything logged: a re-drop's scene starts at t = 0 again, and its log
+        continues after the earlier drops' (one clock per log, so a reader's time order is the trial's)."""
         self.log_every = max(1, round(1.0 / (cfg.sim.log_rate_hz * self.dt)))
         self.gripper: Gripper | None = None
         self._links: list | None = None
@@ -217,10 +227,15 @@ class _Sim:
                 out[name] = (lp.p, lp.q)
         return out
 
+    @property
+    def log_t(self) -> float:
+        """The log's time of now, s (:attr:`log_offset_s` + sim time)."""
+        return self.log_offset_s + self.t
+
     def log(self) -> None:
         t0 = time.perf_counter()
-        self.rec.transforms(self.t, self.frames())
-        self.rec.contacts(self.t, contact_records(self._contacts(), self.dt))
+        self.rec.transforms(self.log_t, self.frames())
+        self.rec.contacts(self.log_t, contact_records(self._contacts(), self.dt))
         self.timings["log"] += time.perf_counter() - t0
 
     @contextmanager
@@ -234,7 +249,7 @@ class _Sim:
 
     def phase(self, name: str, info: dict | None = None) -> None:
         t0 = time.perf_counter()
-        self.rec.phase(self.t, name, info or {})
+        self.rec.phase(self.log_t, name, info or {})
         self.timings["log"] += time.perf_counter() - t0
 
 
@@ -315,19 +330,20 @@ def run_trial(ctx: TrialContext) -> TrialResult:
         res.touched_support = sim.touched_support
         res.sim_time_s, res.steps = sim.t, sim.steps
     res.timings_s = timings
-    ctx.recorder.result(sim.t if sim else 0.0, res.to_dict())
+    ctx.recorder.result(sim.log_t if sim else 0.0, res.to_dict())
     return res
 
 
 def _drop_until_on_support(ctx: TrialContext, res: TrialResult, timings: dict) -> _Sim:
     cfg = ctx.cfg
+    log_offset_s = 0.0
     for attempt in range(cfg.sim.max_redrops + 1):
         rng = rng_for(ctx.trial_seed, "drop", attempt)
         t0 = time.perf_counter()
         pose = drop_pose(ctx.model, cfg.rot.name, cfg.mode.support_height_m, cfg.rot.drop_height_m, rng)
         ts = build_scene(ctx.hulls, ctx.model.mass_kg, pose, cfg.mode, cfg.sim)
         timings["build"] += time.perf_counter() - t0
-        sim = _Sim(ts, cfg, ctx.recorder, timings)
+        sim = _Sim(ts, cfg, ctx.recorder, timings, log_offset_s)
         if attempt == 0 and ctx.scene is not None:
             ctx.recorder.scene(0.0, ctx.scene.static)
         sim.phase("drop", {"attempt": attempt})
@@ -337,6 +353,7 @@ def _drop_until_on_support(ctx: TrialContext, res: TrialResult, timings: dict) -
             sim.phase("settled", {"redrops": attempt})
             return sim
         res.redrops = attempt + 1
+        log_offset_s = sim.log_t + sim.dt
     raise TrialFailed(FailureReason.FELL_OFF_SUPPORT, f"{cfg.sim.max_redrops + 1} drops fell off the support")
 
 
@@ -364,7 +381,7 @@ def _plan(ctx: TrialContext, sim: _Sim) -> Grasp:
     except NoFeasibleGrasp as e:
         raise TrialFailed(FailureReason.NO_FEASIBLE_GRASP, str(e)) from None
     sim.phase("plan")
-    ctx.recorder.grasp(sim.t, _grasp_record(grasp))
+    ctx.recorder.grasp(sim.log_t, _grasp_record(grasp))
     return grasp
 
 
@@ -375,7 +392,7 @@ def _force_closure_mu(ctx: TrialContext, sim: _Sim, grasp: Grasp) -> float:
     in_object = dataclasses.replace(grasp, pose=np.linalg.inv(T) @ grasp.pose)
     mu = ctx.quality(ctx.model.mesh, in_object)
     mu = mu if np.isfinite(mu) else float("nan")
-    ctx.recorder.phase(sim.t, "quality", {"fc_min_mu": mu})
+    ctx.recorder.phase(sim.log_t, "quality", {"fc_min_mu": mu})
     return mu
 
 
@@ -396,7 +413,7 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
     gripper = build_gripper(ts.scene, cfg.gripper, grasp.pose, mode.support_collides_with_gripper)
     sim.gripper = gripper
     if ctx.scene is not None:
-        ctx.recorder.scene(sim.t, ctx.scene.gripper)
+        ctx.recorder.scene(sim.log_t, ctx.scene.gripper)
     if mode.support_collides_with_gripper:
         sim.watch_support(gripper)
     standoff = float(cfg.planner.sphere_radius_m)
@@ -423,7 +440,7 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
     if mode.remove_support_after_grasp:
         sim.phase("remove_support")
         ts.remove_support()
-        ctx.recorder.delete_entities(sim.t, [SUPPORT_NAME])
+        ctx.recorder.delete_entities(sim.log_t, [SUPPORT_NAME])
     if mode.pull_back_m > 0:
         sim.phase("pull_back", {"distance_m": mode.pull_back_m})
         sim.run(

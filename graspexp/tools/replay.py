@@ -14,7 +14,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from graspexp.config import ConfigError, PluginError
 from graspexp.core.bodies import FINGER_NAMES, OBJECT_NAME
+from graspexp.datasets import DatasetError
 from graspexp.record.reader import CorruptLogError, TrialLog, read_trial
 from graspexp.tools.cli import tool_parser
 
@@ -121,7 +123,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         except ImportError as exc:
             print(f"{parser.prog}: error: --resim needs graspexp.run.resim ({exc})", file=sys.stderr)
             return 2
-        agrees, explanation = resimulate(log)
+        try:
+            agrees, explanation = resimulate(log)
+        except (DatasetError, PluginError, ConfigError) as exc:  # the log's mesh, planner or config
+            print(f"{parser.prog}: error: cannot re-simulate {args.file}: {exc}", file=sys.stderr)
+            return 2
         print(f"resim: {'agrees' if agrees else 'DISAGREES'}: {explanation}")
         return 0 if agrees else 1
     return 0
