@@ -90,7 +90,7 @@ def compare(session: nox.Session) -> None:
 @nox.session(venv_backend="none")
 def readings(session: nox.Session) -> None:
     """Every reading of the paper and every other planner on Tables 1 and 2 (``python -m graspexp readings``),
-    then the readings table. ``nox -s readings -- [OUT] [--only a,b] [--trials N]``; resumable."""
+    then the readings table. ``nox -s readings -- [--out OUT] [--only a,b] [trials=N]``; resumable."""
     start = time.perf_counter()
     session.run("python", "-m", "graspexp", "readings", *session.posargs, env=ENV, external=True)
     session.log(f"readings: {time.perf_counter() - start:.0f} s wall")

@@ -192,20 +192,28 @@ ABLATIONS: tuple[Reading, ...] = (
 ALL: dict[str, Reading] = {r.name: r for r in (*READINGS, *PLANNERS, *ABLATIONS)}
 
 
-def reading_sweep(reading: Reading, out: Path, datasets: str, trials: int) -> list[str]:
-    """The multirun that runs one reading on the paper's four settings."""
+def reading_sweep(reading: Reading, out: Path, overrides: tuple[str, ...] | list[str] = ()) -> list[str]:
+    """The multirun that runs one reading on the paper's four settings into ``out/<name>``: Tables 1 and 2
+    at the paper's trial count unless ``overrides`` give ``dataset=`` or ``trials=`` (any other override
+    goes to every job too)."""
+    given = {o.split("=", 1)[0] for o in overrides}
+    defaults = [
+        o
+        for o in (sweep_values("dataset", PAPER_DATASETS), f"trials={TRIALS_PER_SETTING}")
+        if o.split("=", 1)[0] not in given
+    ]
     return [
         sys.executable,
         "-m",
         "graspexp",
         "-m",
         *SETTINGS_SWEEP,
-        f"dataset={datasets}",
-        f"trials={trials}",
+        *defaults,
         "progress=false",
         "hydra/launcher=joblib",
         f"hydra.sweep.dir={out / reading.name}",
         *reading.overrides,
+        *overrides,
     ]
 
 

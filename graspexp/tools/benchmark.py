@@ -11,7 +11,8 @@ entered; ``dataset=`` one dataset or several (``dataset=ycb,linemod``, the defau
 ``objects=[...]`` a subset; ``planner.*`` keys go to the entered planner only, the rest (``gripper=``,
 ``sim.*``, ...) to every planner. Options:
 
-- ``--settings collab/z,bin/xyz``: the settings (default the four);
+- ``mode=collab,bin`` / ``rot=z,xyz``: the settings, every combination of the values given (default the
+  paper's four);
 - ``--noise 10:0,0:10``: pose-noise levels ``trans_mm:rot_deg`` besides zero (``--noise ''``: none);
 - ``--compare obb,random``: planners ranked beside it (default the built-in ones; they run too where
   their results are missing, once, and are reused by every later entrant);
@@ -113,7 +114,7 @@ class Job:
 
 
 PROG = "graspexp benchmark"
-SUITE_KEYS = ("planner", "dataset", "trials", "objects")
+SUITE_KEYS = ("planner", "dataset", "mode", "rot", "trials", "objects")
 """Job keys whose values choose the suite (the other overrides are passed on to every job)."""
 
 
@@ -135,7 +136,6 @@ def _noise_levels(text: str) -> list[list[float]]:
 def arg_parser() -> argparse.ArgumentParser:
     """The benchmark's command line (module doc)."""
     parser = tool_parser(PROG, __doc__, overrides=True)
-    parser.add_argument("--settings", type=_names, help="comma-separated mode/rot (default: the four)")
     parser.add_argument("--noise", type=_noise_levels, help="trans_mm:rot_deg levels besides zero")
     parser.add_argument(
         "--compare", type=_names, help="planners ranked beside it (default: the built-in ones)"
@@ -158,16 +158,19 @@ def parse_args(argv: list[str]) -> Benchmark:
             values["overrides"].append(tok)
         elif key == "dataset":
             values["datasets"] = _names(raw)
+        elif key in ("mode", "rot"):
+            values[key] = _names(raw)
         else:
             values[key] = yaml.safe_load(raw) if key != "planner" else raw
     if "planner" not in values:
         raise ConfigError("planner is missing: python -m graspexp benchmark planner=NAME [dataset=...]")
-    options = ("settings", "noise", "compare", "out", "n_jobs", "launcher", "slurm_partition", "timeout_min")
-    bench = Benchmark(**values, **{k: getattr(args, k) for k in options if getattr(args, k) is not None})
-    for s in bench.settings:
-        if s.count("/") != 1:
-            raise ConfigError(f"--settings entry {s!r} is invalid: expected mode/rot, e.g. collab/z")
-    return bench
+    modes, rots = values.pop("mode", None), values.pop("rot", None)
+    if modes or rots:  # every combination of the given modes and rotations, in the paper's order
+        paper_modes = list(dict.fromkeys(m for m, _ in SETTINGS))
+        paper_rots = list(dict.fromkeys(r for _, r in SETTINGS))
+        values["settings"] = [f"{m}/{r}" for m in (modes or paper_modes) for r in (rots or paper_rots)]
+    options = ("noise", "compare", "out", "n_jobs", "launcher", "slurm_partition", "timeout_min")
+    return Benchmark(**values, **{k: getattr(args, k) for k in options if getattr(args, k) is not None})
 
 
 def compared(bench: Benchmark) -> list[str]:

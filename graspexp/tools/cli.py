@@ -67,6 +67,26 @@ def compose_checked(overrides: Sequence[str], prog: str = "graspexp") -> DictCon
         raise  # unreachable: fail exits
 
 
+def take_sweep(overrides: Sequence[str], key: str, default: Sequence[str]) -> tuple[list[str], list[str]]:
+    """The values a tool sweeps itself for ``key`` (Hydra's syntax: ``key=a,b``, or one value), else
+    ``default``, and the other overrides; a malformed override exits with one line."""
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+
+    values, rest = list(default), []
+    for text in overrides:
+        try:
+            (o,) = OverridesParser.create().parse_overrides([text])
+        except Exception as exc:  # a syntax error in an override
+            fail(one_line(exc))
+        if o.get_key_element() != key:
+            rest.append(text)
+        elif o.is_sweep_override():
+            values = [str(v) for v in o.sweep_string_iterator()]
+        else:
+            values = [o.get_value_element_as_str()]
+    return values, rest
+
+
 def check_overrides(overrides: Sequence[str], multirun: bool = True) -> None:
     """Compose and validate every combination of the (possibly swept) overrides; exit 2 on the first error
     (also for a sweep without ``multirun``)."""

@@ -2,7 +2,7 @@
 
 Usage::
 
-    python -m graspexp figures --object 025_mug [--out DIR] dataset=ycb [mode=bin]
+    python -m graspexp figures objects=[025_mug] [--out DIR] dataset=ycb [mode=bin]
     python -m graspexp figures --all [--out DIR] dataset=ycb
 
 ``key=value`` arguments are Hydra overrides, as for :mod:`graspexp.tools.plan` (the object is placed upright on
@@ -220,22 +220,28 @@ def main(argv: Sequence[str] | None = None) -> int:
     """CLI entry; returns the exit status."""
     prog = "graspexp figures"
     parser = tool_parser(prog, __doc__.splitlines()[0], overrides=True)
-    which = parser.add_mutually_exclusive_group(required=True)
-    which.add_argument("--object", metavar="NAME", help="draw the figures of this object, e.g. 025_mug")
-    which.add_argument("--all", action="store_true", help="every available object, and the areas overview")
+    parser.add_argument(
+        "--all",
+        action="store_true",
+        help="every available object (instead of objects=[...]) and the areas overview",
+    )
     parser.add_argument(
         "--out", type=Path, help="output folder (default outputs/figures/<dataset>[/<object>])"
     )
     args = parser.parse_intermixed_args(argv)
     cfg = compose_checked(args.overrides, prog)
     base = args.out or Path("outputs") / "figures" / str(cfg.dataset.name)
-    if args.object:
-        try:
-            planned = plan_upright(cfg, job_object(cfg, args.object))
-        except (DatasetError, NoFeasibleGrasp, UnknownPlanner) as err:
-            fail(f"{args.object}: {err}", prog)
-        for p in draw_object(planned, args.out or base / args.object):
-            print(p)
+    if bool(cfg.objects) == args.all:
+        fail("name the objects to draw, objects=[NAME,...] (e.g. objects=[025_mug]), or --all", prog)
+    if cfg.objects:
+        for name in cfg.objects:
+            try:
+                planned = plan_upright(cfg, job_object(cfg, name))
+            except (DatasetError, NoFeasibleGrasp, UnknownPlanner) as err:
+                fail(f"{name}: {err}", prog)
+            out = args.out if args.out and len(cfg.objects) == 1 else base / name
+            for p in draw_object(planned, out):
+                print(p)
         return 0
     names = available_objects(cfg.dataset)
     if not names:

@@ -2,8 +2,8 @@
 
 Usage::
 
-    python -m graspexp plan --object 025_mug [--dump FILE.npz] dataset=ycb [mode=bin] [gripper=panda]
-    GRASPEXP_DATA=/path/to/datasets python -m graspexp plan --object 025_mug dataset=ycb
+    python -m graspexp plan objects=[025_mug] [--dump FILE.npz] dataset=ycb [mode=bin] [gripper=panda]
+    GRASPEXP_DATA=/path/to/datasets python -m graspexp plan objects=[025_mug] dataset=ycb
 
 ``key=value`` arguments are Hydra overrides of ``conf/config.yaml`` (composed with Hydra's compose API, so
 no output folder is created). ``--dump FILE.npz`` saves every intermediate of the plan (the keys of
@@ -67,16 +67,16 @@ def dump(path: str, planned: PlannedObject) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """CLI entry; returns the exit status."""
     parser = tool_parser(PROG, __doc__.splitlines()[0], overrides=True)
-    parser.add_argument(
-        "--object", required=True, metavar="NAME", help="the object to plan for, e.g. 025_mug"
-    )
     parser.add_argument("--dump", metavar="FILE.npz", help="save every intermediate of the plan")
     args = parser.parse_intermixed_args(argv)
     cfg = compose_checked(args.overrides, PROG)
+    if not cfg.objects or len(cfg.objects) != 1:
+        fail("name the one object to plan for: objects=[NAME], e.g. objects=[025_mug]", PROG)
+    name = str(cfg.objects[0])
     try:
-        planned = plan_upright(cfg, job_object(cfg, args.object))
+        planned = plan_upright(cfg, job_object(cfg, name))
     except (DatasetError, NoFeasibleGrasp, UnknownPlanner) as err:
-        fail(f"{args.object}: {err}" if not isinstance(err, DatasetError) else str(err), PROG)
+        fail(f"{name}: {err}" if not isinstance(err, DatasetError) else str(err), PROG)
     if args.dump:
         dump(args.dump, planned)
     print(json.dumps(grasp_record(cfg, planned)))

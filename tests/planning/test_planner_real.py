@@ -75,7 +75,7 @@ def test_plan_every_real_object_in_both_modes(data_root, dataset):
 def test_plan_cli_prints_one_json_object_and_dumps(tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
     dump = tmp_path / "mug.npz"
-    assert plan_main(["dataset=primitives", "--object", "mug", "mode=bin", "--dump", str(dump)]) == 0
+    assert plan_main(["dataset=primitives", "objects=[mug]", "mode=bin", "--dump", str(dump)]) == 0
     out = capsys.readouterr().out.strip().splitlines()
     assert len(out) == 1
     rec = json.loads(out[0])
@@ -100,7 +100,7 @@ def test_plan_cli_prints_one_json_object_and_dumps(tmp_path, capsys, monkeypatch
 @pytest.mark.slow
 def test_plan_cli_unknown_object_is_one_line_and_non_zero():
     proc = subprocess.run(
-        [sys.executable, "-m", "graspexp", "plan", "dataset=primitives", "--object=teapot"],
+        [sys.executable, "-m", "graspexp", "plan", "dataset=primitives", "objects=[teapot]"],
         capture_output=True,
         text=True,
         timeout=120,
@@ -115,7 +115,7 @@ def test_plan_cli_unknown_object_is_one_line_and_non_zero():
 def test_figures_cli_writes_the_pngs(tmp_path, planner):
     from graspexp.tools.figures import main as figures_main
 
-    args = ["dataset=primitives", f"planner={planner}", "--object", "mug", "--out", str(tmp_path)]
+    args = ["dataset=primitives", f"planner={planner}", "objects=[mug]", "--out", str(tmp_path)]
     assert figures_main(args) == 0
     names = sorted(p.name for p in tmp_path.glob("*.png"))
     assert names == [

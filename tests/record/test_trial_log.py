@@ -165,7 +165,7 @@ def test_collab_log_valid_and_deletes_the_support_when_removed(collab_log):
 def test_trial_bench_prints_both_ratios_for_both_modes(capsys):
     from graspexp.tools.bench.trials import main
 
-    main(["--objects", "can", "--trials", "1", "--repeats", "0"])
+    main(["objects=[can]", "trials=1", "--repeats", "0"])
     out = capsys.readouterr().out
     for mode in ("collab", "bin"):
         block = out.split(f"[{mode}]")[1]

@@ -121,8 +121,16 @@ def test_a_reading_directory_with_two_configs_is_refused(readings_dir: Path, tmp
 
 def test_readings_command_shape_and_bad_names(tmp_path: Path, capsys) -> None:
     assert [r.name for r in READINGS[:3]] == ["default", "in_area", "literal"]
-    cmd = reading_sweep(ALL["r_rms"], tmp_path, "ycb,linemod", 10)
+    cmd = reading_sweep(ALL["r_rms"], tmp_path)
     assert cmd[-2:] == ["planner=optimal", "planner.cluster_radius=rms"]
     assert "mode=collab,bin" in cmd and "rot=z,xyz" in cmd and f"hydra.sweep.dir={tmp_path / 'r_rms'}" in cmd
-    assert readings_main([str(tmp_path), "--only", "nope", "--report-only"]) == 2
+    assert "dataset=ycb,linemod" in cmd and "trials=10" in cmd
+    assert reading_sweep(ALL["r_rms"], tmp_path, ["trials=3", "gripper=panda"])[-4:] == [
+        "planner=optimal",
+        "planner.cluster_radius=rms",
+        "trials=3",
+        "gripper=panda",
+    ]
+    assert "trials=10" not in reading_sweep(ALL["r_rms"], tmp_path, ["trials=3"])
+    assert readings_main(["--out", str(tmp_path), "--only", "nope", "--report-only"]) == 2
     assert "unknown ['nope']" in capsys.readouterr().err

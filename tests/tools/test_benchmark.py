@@ -30,8 +30,6 @@ def test_standard_suite_is_four_settings_on_both_tables_at_every_noise_level_for
 def test_bad_arguments_are_one_clear_error():
     with pytest.raises(ConfigError, match="planner is missing"):
         parse_args(["dataset=ycb"])
-    with pytest.raises(ConfigError, match="--settings entry 'collab' is invalid: expected mode/rot"):
-        parse_args(["planner=obb", "--settings", "collab"])
     with pytest.raises(SystemExit):  # argparse: usage and "invalid choice: 'pbs'"
         parse_args(["planner=obb", "--launcher", "pbs"])
 
@@ -39,8 +37,8 @@ def test_bad_arguments_are_one_clear_error():
 def test_options_and_suite_keys_are_read_and_the_rest_goes_to_the_jobs():
     bench = parse_args(
         [
-            "--settings",
-            "collab/z",
+            "mode=collab",
+            "rot=z",
             "--noise",
             "5:0,0:5",
             "--compare",
@@ -60,6 +58,9 @@ def test_options_and_suite_keys_are_read_and_the_rest_goes_to_the_jobs():
     assert bench.settings == ["collab/z"] and bench.noise == [[5.0, 0.0], [0.0, 5.0]]
     assert bench.compare == ["obb"] and bench.n_jobs == 1 and bench.overrides == ["sim.close_s=0.5"]
     assert parse_args(["planner=obb", "--noise", ""]).noise == []
+    # settings: every combination of the given modes and rotations, in the paper's order
+    assert parse_args(["planner=obb", "rot=xyz"]).settings == ["collab/xyz", "bin/xyz"]
+    assert parse_args(["planner=obb", "mode=bin,collab", "rot=z"]).settings == ["bin/z", "collab/z"]
 
 
 def test_ranking_puts_the_best_first_and_the_paper_printed_average_last():

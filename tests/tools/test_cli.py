@@ -101,7 +101,7 @@ def test_a_tool_with_a_bad_override_is_one_line(capsys):
     from graspexp.tools.plan import main
 
     with pytest.raises(SystemExit) as done:
-        main(["--object", "mug", "mode=foo"])
+        main(["objects=[mug]", "mode=foo"])
     assert done.value.code == 2
     assert capsys.readouterr().err == (
         "graspexp plan: error: In 'config': Could not find 'mode/foo'; Available options in 'mode': bin, collab\n"

@@ -21,8 +21,8 @@ def test_pick_shortlisted_prefers_room_by_the_finger_edges_then_cost() -> None:
 @pytest.mark.sim
 def test_shortlist_study_simulates_every_shortlisted_grasp(tmp_path, capsys) -> None:
     out = tmp_path / "shortlist.csv"
-    argv = ["--out", str(out), "--trials", "1", "--datasets", "primitives", "--objects", "can"]
-    assert shortlist_main([*argv, "--settings", "collab/z", "--workers", "1"]) == 0
+    argv = ["--out", str(out), "trials=1", "dataset=primitives", "objects=[can]"]
+    assert shortlist_main([*argv, "mode=collab", "rot=z", "--n-jobs", "1"]) == 0
     df = pd.read_csv(out)
     assert len(df) == df["candidate"].max() + 1 > 1  # every shortlisted grasp of the one drop, once
     assert df["pick_edge_clearance"].sum() == 1

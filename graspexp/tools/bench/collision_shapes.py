@@ -1,8 +1,8 @@
 """Collision-shape benchmark: each object's collision shape against its mesh, its cold preparation
 time and its physics cost per step.
 
-    python -m graspexp bench.collision_shapes [--objects all|ycb|linemod|a,b] [--method mesh,coacd,vhacd]
-        [--trials 3] [--csv FILE] [sim.coacd_threshold=0.05 ...]
+    python -m graspexp bench.collision_shapes [--out DIR] [dataset=ycb,linemod] [objects=[a,b]]
+        [sim.collision_method=mesh,coacd,vhacd] [trials=3] [sim.coacd_threshold=0.05 ...]
 
 Per object and method: collision parts, their triangles, cold preparation (built into an empty
 temporary cache; wall and CPU seconds of this process, all its threads), the first scene build
@@ -10,9 +10,11 @@ temporary cache; wall and CPU seconds of this process, all its threads), the fir
 outside the mesh (median, 90th percentile, max; mm, see :mod:`graspexp.sim.collision_accuracy`) and
 inside it (90th percentile), how far the mesh surface lies outside the collision shape
 (``uncovered_p90_mm``: missing material, e.g. a dropped part), the physics wall time per step with the object resting on the support box
-(``rest_us``) and, median over ``--trials`` full collab trials with the gripper closing on it
-(``trial_us``). Prints one row per object, then the median and worst per method, and writes a CSV.
-Other arguments are Hydra overrides (e.g. ``sim.coacd_threshold=0.05``).
+(``rest_us``) and, median over ``trials=`` (default 3) full collab trials with the gripper closing on it
+(``trial_us``). Prints one row per object, then the median and worst per method, and writes
+``DIR/collision_shapes.csv`` (default ``outputs/bench``). ``dataset=`` and ``sim.collision_method=`` take
+several values (default ``ycb,linemod`` and ``mesh``); ``objects=[...]`` picks staged objects (default every
+staged one); other arguments are Hydra overrides (e.g. ``sim.coacd_threshold=0.05``).
 """
 
 import statistics
@@ -36,7 +38,7 @@ from graspexp.sim.collision_accuracy import shape_accuracy, surface_points, unco
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.scene import build_scene
 from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
-from graspexp.tools.cli import tool_parser
+from graspexp.tools.cli import take_sweep, tool_parser
 
 REST_STEPS = 600
 """Steps of the resting scene (2.5 s at 1/240 s), after the object has landed."""
@@ -110,35 +112,33 @@ def measure(overrides: list[str], dataset: str, name: str, trials: int, samples:
     }
 
 
-def _objects(spec: str) -> list[tuple[str, str]]:
+def _objects(datasets: list[str], objects: list[str]) -> list[tuple[str, str]]:
+    """(dataset, object) of every staged object of ``datasets``, or of those named in ``objects``."""
     pairs = []
-    for ds in ("ycb", "linemod"):
+    for ds in datasets:
         names = staged_objects(compose_config([f"dataset={ds}"]).dataset)
-        if spec in ("all", ds):
-            pairs += [(ds, n) for n in names]
-        elif spec not in ("all", "ycb", "linemod"):
-            pairs += [(ds, n) for n in spec.split(",") if n in names]
+        pairs += [(ds, n) for n in names if not objects or n in objects]
     return pairs
 
 
 def main(argv: list[str] | None = None) -> None:
     ap = tool_parser("graspexp bench.collision_shapes", __doc__.splitlines()[0], overrides=True)
-    ap.add_argument("--objects", default="all", help="all, ycb, linemod or comma-separated names")
-    ap.add_argument("--method", default="mesh", help="comma-separated sim.collision_method values")
-    ap.add_argument("--trials", type=int, default=3, help="collab trials per object for trial_us")
+    ap.add_argument("--out", type=Path, default=Path("outputs/bench"), help="output folder")
     ap.add_argument("--samples", type=int, default=10000, help="collision-surface samples per object")
-    ap.add_argument("--csv", default="outputs/bench/collision_shapes.csv", help="where to write the table")
     args = ap.parse_intermixed_args(argv)
     threadpool_limits(limits=1)
-    pairs = _objects(args.objects)
+    datasets, rest = take_sweep(args.overrides, "dataset", ["ycb", "linemod"])
+    methods, rest = take_sweep(rest, "sim.collision_method", ["mesh"])
+    objects, rest = take_sweep(rest, "objects", [])
+    trials, rest = take_sweep(rest, "trials", ["3"])
+    names = [n.strip() for o in objects for n in o.strip("[]").split(",") if n.strip()]
+    pairs = _objects(datasets, names)
     if not pairs:
-        ap.error(f"no staged object matches --objects {args.objects!r}")
+        ap.error(f"no staged object of {','.join(datasets)} matches objects={objects}")
     rows = []
-    for method in args.method.split(","):
+    for method in methods:
         for ds, name in pairs:
-            row = measure(
-                [*args.overrides, f"sim.collision_method={method}"], ds, name, args.trials, args.samples
-            )
+            row = measure([*rest, f"sim.collision_method={method}"], ds, name, int(trials[0]), args.samples)
             rows.append(row)
             print(
                 f"{method:6s} {name:26s} parts {row['parts']:3d} prep {row['prep_wall_s']:6.1f} s "
@@ -149,7 +149,7 @@ def main(argv: list[str] | None = None) -> None:
                 flush=True,
             )
     df = pd.DataFrame(rows)
-    out = Path(args.csv)
+    out = args.out / "collision_shapes.csv"
     out.parent.mkdir(parents=True, exist_ok=True)
     df.to_csv(out, index=False)
     print()

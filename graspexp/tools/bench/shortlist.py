@@ -1,8 +1,8 @@
 """Shortlist study: every grasp ``optimal_plus`` shortlists, simulated one at a time on the same drop,
 beside what the planner measured of it.
 
-    python -m graspexp bench.shortlist [--out shortlist.csv] [--trials 5] [--settings collab/z,bin/xyz]
-        [--datasets ycb,linemod] [--objects a,b] [--workers 2] [key=value ...]
+    python -m graspexp bench.shortlist [--out shortlist.csv] [--n-jobs 2] [trials=5] [mode=collab,bin]
+        [rot=z,xyz] [dataset=ycb,linemod] [objects=[a,b]] [key=value ...]
 
 For each dataset, setting, object and trial the planner runs once; each of its S shortlisted paths
 (``details["shortlist_*"]``, graspexp/planning/optimal_plus.py) is then executed in a fresh trial on the
@@ -10,7 +10,9 @@ same drop by a planner that returns that grasp. One CSV row per simulated grasp:
 reason, the edge excess (how far the object reaches past a pad's contact plane by the finger edges, the
 measure ``choose_by=edge_clearance`` minimises), the pad depth, whether it passed the noise check, and
 which grasp each ``choose_by`` rule picks. Prints the share held per band of edge excess and how often each
-rule's pick is held. ``key=value`` arguments are job overrides (``planner.*``, ``sim.*``, ...).
+rule's pick is held. ``key=value`` arguments are job overrides (``planner.*``, ``sim.*``, ...); ``dataset=``,
+``mode=`` and ``rot=`` take several values (every combination runs; default the paper's), ``trials=`` is
+the drops per object and setting (default 5), ``objects=[...]`` a subset (default every staged one).
 """
 
 from __future__ import annotations
@@ -32,9 +34,10 @@ from graspexp.planning.optimal_plus import pick_shortlisted
 from graspexp.planning.request import PlanResult
 from graspexp.quality import fc_min_mu
 from graspexp.report.paper import SETTINGS
+from graspexp.run.suites import PAPER_DATASETS
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
-from graspexp.tools.cli import compose_checked, fail, tool_parser
+from graspexp.tools.cli import compose_checked, fail, take_sweep, tool_parser
 
 PROG = "graspexp bench.shortlist"
 RULES = ("edge_clearance", "cost")
@@ -108,18 +111,18 @@ def study(
     overrides: list[str],
     datasets: list[str],
     settings: list[str],
-    objects: list[str],
     trials: int,
     workers: int,
 ) -> pd.DataFrame:
-    """One row per simulated shortlisted grasp (module doc), every dataset x setting x object."""
+    """One row per simulated shortlisted grasp (module doc), every dataset x ``mode/rot`` setting x object
+    (``objects=[...]`` among ``overrides``, else every staged one)."""
     jobs = []
     for dataset in datasets:
         for setting in settings:
             mode, rot = setting.split("/")
             job = [f"dataset={dataset}", f"mode={mode}", f"rot={rot}", "planner=optimal_plus", *overrides]
             cfg = compose_checked(job, PROG)
-            names = objects or available_objects(cfg.dataset)
+            names = list(cfg.objects) if cfg.objects else available_objects(cfg.dataset)
             jobs += [((job, n, trials), dataset, setting) for n in names]
     frames = []
     with ProcessPoolExecutor(workers) as pool:
@@ -157,26 +160,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--out", type=Path, default=Path("shortlist.csv"), help="CSV written (default shortlist.csv)"
     )
-    ap.add_argument("--trials", type=int, default=5, help="drops per object and setting (default 5)")
-    ap.add_argument(
-        "--settings", default=",".join("/".join(s) for s in SETTINGS), help="comma-separated mode/rot"
-    )
-    ap.add_argument("--datasets", default="ycb,linemod", help="comma-separated datasets")
-    ap.add_argument("--objects", default="", help="comma-separated object names (default: every staged one)")
-    ap.add_argument("--workers", type=int, default=2, help="processes (default 2)")
+    ap.add_argument("--n-jobs", type=int, default=2, help="processes (default 2)")
     args = ap.parse_intermixed_args(argv)
-    settings = [s for s in args.settings.split(",") if s]
-    for s in settings:
-        if s.count("/") != 1:
-            fail(f"--settings entry {s!r} is invalid: expected mode/rot, e.g. collab/z", PROG)
-    df = study(
-        list(args.overrides),
-        [d for d in args.datasets.split(",") if d],
-        settings,
-        [o for o in args.objects.split(",") if o],
-        args.trials,
-        args.workers,
-    )
+    if args.n_jobs < 1:
+        fail(f"--n-jobs {args.n_jobs} is invalid: expected 1 or more processes", PROG)
+    datasets, rest = take_sweep(args.overrides, "dataset", PAPER_DATASETS)
+    modes, rest = take_sweep(rest, "mode", dict.fromkeys(m for m, _ in SETTINGS))
+    rots, rest = take_sweep(rest, "rot", dict.fromkeys(r for _, r in SETTINGS))
+    trials, rest = take_sweep(rest, "trials", ["5"])
+    if len(trials) != 1 or not trials[0].isdigit() or int(trials[0]) < 1:
+        fail(f"trials={','.join(trials)} is invalid: expected one positive integer", PROG)
+    settings = [f"{m}/{r}" for m in modes for r in rots]
+    df = study(rest, datasets, settings, int(trials[0]), args.n_jobs)
     if df.empty:
         fail("no grasp was planned: nothing to simulate", PROG)
     df.to_csv(args.out, index=False)

@@ -1,7 +1,10 @@
 """Trial benchmark: per-phase time split, the overhead ratio of a trial to its physics steps with and
 without MCAP logging (side by side, collab and bin), and trials/s with 1 and 2 processes.
 
-    python -m graspexp bench.trials [dataset=ycb] [--modes collab,bin] [--trials 10] [--objects a,b]
+    python -m graspexp bench.trials [dataset=ycb] [mode=collab,bin] [trials=10] [objects=[a,b]] [--repeats 3]
+
+``mode=`` takes several values, measured one after the other (default ``collab,bin``); ``trials=`` trials
+per object (the job config's, 10); ``objects=[...]`` a subset (default every staged object).
 
 The overhead ratio is (wall time of the whole trial: scene build, settling, planning, force-closure check,
 execution, logging) / (time inside the physics steps of the same trial). Logged and unlogged runs of each
@@ -28,7 +31,7 @@ from graspexp.record import TrialRecorder
 from graspexp.record.scene import object_scene
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
-from graspexp.tools.cli import compose_checked, tool_parser
+from graspexp.tools.cli import compose_checked, take_sweep, tool_parser
 
 PHASES = ("build", "settle", "plan", "quality", "execute", "log")
 TARGET_LOGGED, TARGET_UNLOGGED = 1.3, 1.2
@@ -190,28 +193,24 @@ def report_mode(mode: str, rows: dict[str, list[dict]], log_rate_hz: float) -> N
 
 def main(argv: list[str] | None = None) -> None:
     ap = tool_parser("graspexp bench.trials", __doc__.splitlines()[0], overrides=True)
-    ap.add_argument(
-        "--modes", default="collab,bin", help="comma-separated modes, measured one after the other"
-    )
-    ap.add_argument("--trials", type=int, default=10, help="trials per object")
-    ap.add_argument("--objects", default="", help="comma-separated subset")
     ap.add_argument("--repeats", type=int, default=3, help="repeats of the throughput runs (0: skip them)")
     args = ap.parse_intermixed_args(argv)
     threadpool_limits(limits=1)
-    modes = args.modes.split(",")
-    cfg = compose_checked([*args.overrides, f"mode={modes[0]}"], ap.prog)
-    names = args.objects.split(",") if args.objects else available_objects(cfg.dataset)
+    modes, rest = take_sweep(args.overrides, "mode", ["collab", "bin"])
+    cfg = compose_checked([*rest, f"mode={modes[0]}"], ap.prog)
+    names = list(cfg.objects) if cfg.objects else available_objects(cfg.dataset)
+    trials = int(cfg.trials)
     print(
-        f"trial benchmark: {cfg.dataset.name} rot={cfg.rot.name}, modes {modes}, {len(names)} objects x {args.trials}"
+        f"trial benchmark: {cfg.dataset.name} rot={cfg.rot.name}, modes {modes}, {len(names)} objects x {trials}"
     )
     for mode in modes:
-        overrides = [*args.overrides, f"mode={mode}"]
-        rows = bench_mode(overrides, names, args.trials)
+        overrides = [*rest, f"mode={mode}"]
+        rows = bench_mode(overrides, names, trials)
         report_mode(mode, rows, float(compose_config(overrides).sim.log_rate_hz))
     if args.repeats > 0:
-        overrides = [*args.overrides, f"mode={modes[0]}"]
+        overrides = [*rest, f"mode={modes[0]}"]
         tp = {
-            w: statistics.median(_throughput(overrides, names, args.trials, w) for _ in range(args.repeats))
+            w: statistics.median(_throughput(overrides, names, trials, w) for _ in range(args.repeats))
             for w in (1, 2)
         }
         print(
