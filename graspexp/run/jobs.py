@@ -60,12 +60,14 @@ def job_dir_name(overrides: list[str], exclude_keys: list[str]) -> str:
 
 
 def register_resolvers() -> None:
-    """``${graspexp.job_dir:${hydra.overrides.task},${...exclude_keys}}`` (see :func:`job_dir_name`)."""
+    """``${graspexp.job_dir:${hydra.overrides.task},${...exclude_keys}}`` (see :func:`job_dir_name`) and
+    ``${graspexp.g:${x}}`` (a number as Python's ``{:g}`` writes it, for directory names)."""
     OmegaConf.register_new_resolver(
         "graspexp.job_dir",
         lambda overrides, exclude: job_dir_name(list(overrides), list(exclude)),
         replace=True,
     )
+    OmegaConf.register_new_resolver("graspexp.g", lambda x: f"{float(x):g}", replace=True)
 
 
 register_resolvers()  # job processes of joblib/submitit import this module with the pickled callback

@@ -16,9 +16,13 @@ entered; ``dataset=`` one dataset or several (``dataset=ycb,linemod``, the defau
 - ``--noise 10:0,0:10``: pose-noise levels ``trans_mm:rot_deg`` besides zero (``--noise ''``: none);
 - ``--compare obb,random``: planners ranked beside it (default the built-in ones; they run too where
   their results are missing, once, and are reused by every later entrant);
-- ``--out DIR`` (default ``outputs/benchmark``); ``--n-jobs N`` (default 2): jobs in parallel with joblib;
-- ``--launcher submitit``: one SLURM array task per job through submitit (``--slurm-partition``,
-  ``--timeout-min``; where no SLURM exists submitit runs them as local processes).
+- ``--out DIR`` (default ``outputs/benchmark``); ``--n-jobs N`` (default 2): jobs in parallel with Hydra's
+  joblib launcher;
+- ``--launcher submitit``: Hydra's submitit launcher, one SLURM array task per job (``--slurm-partition``,
+  ``--timeout-min``; without a partition, local processes).
+
+Jobs launch as every graspexp sweep does: one Hydra multirun per planner (``python -m graspexp -m ...``),
+so a job that cannot run is named in that sweep's failure summary and the others run.
 
 Output, one folder per planner, ``OUT/<planner>/``: ``runs/<dataset>/<mode>_<rot>_t<mm>_r<deg>/`` (the
 runner's job directories: resumable, locked, one MCAP log per trial), ``summary.md`` (ranking and tables),
@@ -33,6 +37,7 @@ import argparse
 import dataclasses
 import json
 import math
+import subprocess
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,9 +47,8 @@ import yaml
 from omegaconf import OmegaConf
 
 from graspexp.config import ConfigError, PluginError
-from graspexp.config.compose import compose_config
 from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
-from graspexp.report.collect import collect
+from graspexp.report.collect import RESULTS_CSV, collect
 from graspexp.report.compare import FC_MU, check_same_drops, render_markdown
 from graspexp.report.compare import success_by_noise as noise_success_table
 from graspexp.report.contact_area import IN_AREA_TOLERANCE_M, finger_contacts_in_area
@@ -215,31 +219,61 @@ def jobs(bench: Benchmark) -> list[Job]:
     return out
 
 
-def run_one(job: Job) -> str:
-    """Run (or resume) one job; '' on success, else the one-line reason."""
-    from graspexp.run.runner import run_in_dir
+RUN_SUBDIR = (
+    "${dataset.name}/${mode.name}_${rot.name}"
+    "_t${graspexp.g:${perception.noise.trans_mm}}_r${graspexp.g:${perception.noise.rot_deg}}"
+)
+"""Each job's directory below ``OUT/<planner>/runs`` (Hydra's ``hydra.sweep.subdir``), as :func:`jobs`
+names it: ``<dataset>/<mode>_<rot>_t<mm>_r<deg>``."""
+JOB_KEYS = ("planner", "dataset", "mode", "rot", "perception.noise.trans_mm", "perception.noise.rot_deg")
+"""The overrides a job of :func:`jobs` sets itself; the sweep of one planner sweeps them."""
 
-    try:
-        run_in_dir(compose_config(list(job.overrides)), Path(job.run_dir))
-    except Exception as exc:  # one job's failure is reported; the others run
-        return f"{job.run_dir}: {type(exc).__name__}: {exc}"
-    return ""
+
+def sweep_command(bench: Benchmark, planner_jobs: list[Job]) -> list[str]:
+    """One Hydra multirun that runs every job of one planner (the same planner and overrides; every
+    combination of their datasets, settings and noise levels), each into its :attr:`Job.run_dir`, with
+    the joblib launcher (``--n-jobs``) or submitit (SLURM with ``--slurm-partition``, else local)."""
+    first = planner_jobs[0]
+    rest = [o for o in first.overrides if o.split("=", 1)[0] not in JOB_KEYS]
+    levels = dict.fromkeys((j.trans_mm, j.rot_deg) for j in planner_jobs)
+    noise = ",".join(f"{{trans_mm:{t:g},rot_deg:{r:g}}}" for t, r in levels)
+    if bench.launcher == "submitit":
+        kind = "submitit_slurm" if bench.slurm_partition else "submitit_local"
+        launcher = [f"hydra/launcher={kind}", f"hydra.launcher.timeout_min={bench.timeout_min}"]
+        launcher += ["hydra.launcher.cpus_per_task=1"]
+        launcher += [f"hydra.launcher.partition={bench.slurm_partition}"] if bench.slurm_partition else []
+    else:
+        launcher = ["hydra/launcher=joblib", f"hydra.launcher.n_jobs={bench.n_jobs}"]
+    return [
+        sys.executable,
+        "-m",
+        "graspexp",
+        "-m",
+        f"planner={first.planner}",
+        f"dataset={','.join(dict.fromkeys(j.dataset for j in planner_jobs))}",
+        f"mode={','.join(dict.fromkeys(j.mode for j in planner_jobs))}",
+        f"rot={','.join(dict.fromkeys(j.rot for j in planner_jobs))}",
+        f"perception.noise={noise}",
+        *rest,
+        f"hydra.sweep.dir={Path(bench.out) / first.planner / 'runs'}",
+        f"hydra.sweep.subdir='{RUN_SUBDIR}'",  # quoted: Hydra resolves it per job
+        *launcher,
+    ]
 
 
 def run_all(bench: Benchmark, todo: list[Job]) -> list[str]:
-    """Run the jobs (joblib processes, or submitit / SLURM); the error line of each failed job."""
-    if bench.launcher == "submitit":
-        import submitit
-
-        executor = submitit.AutoExecutor(folder=Path(bench.out) / "submitit")
-        params = {"timeout_min": bench.timeout_min, "cpus_per_task": 1}
-        if bench.slurm_partition:
-            params["slurm_partition"] = bench.slurm_partition
-        executor.update_parameters(**params)
-        return [e for e in (j.result() for j in executor.map_array(run_one, todo)) if e]
-    from joblib import Parallel, delayed
-
-    return [e for e in Parallel(n_jobs=bench.n_jobs)(delayed(run_one)(j) for j in todo) if e]
+    """Run (or resume) the jobs, one Hydra multirun per planner (a failed job is named in its sweep's
+    failure summary on stderr; the others run); the error line of each job left without results."""
+    errors = []
+    by_planner: dict[str, list[Job]] = {}
+    for job in todo:
+        by_planner.setdefault(job.planner, []).append(job)
+    for planner_jobs in by_planner.values():
+        rc = subprocess.call(sweep_command(bench, planner_jobs))
+        for job in planner_jobs:
+            if not (Path(job.run_dir) / RESULTS_CSV).is_file():
+                errors.append(f"{job.run_dir}: no results (the sweep of {job.planner} exited {rc})")
+    return errors
 
 
 def results(all_jobs: list[Job]) -> pd.DataFrame:

@@ -1,11 +1,14 @@
 """The benchmark command's suite, arguments and ranking (no physics: the end-to-end run is in test_plugin)."""
 
+import dataclasses
+from pathlib import Path
+
 import pandas as pd
 import pytest
 
 from graspexp.config import ConfigError
 from graspexp.report.paper import PAPER_TABLES, SETTINGS
-from graspexp.tools.benchmark import NOISE_LEVELS, compared, jobs, parse_args, ranking
+from graspexp.tools.benchmark import NOISE_LEVELS, compared, jobs, parse_args, ranking, sweep_command
 
 
 def test_standard_suite_is_four_settings_on_both_tables_at_every_noise_level_for_every_planner():
@@ -77,3 +80,25 @@ def test_ranking_puts_the_best_first_and_the_paper_printed_average_last():
     assert table["collab/z"].iloc[1] == "50 [9, 91] (2)"
     assert table["in-area contact %"].iloc[0] == "50" and table["failures"].iloc[1] == "dropped 1"
     assert table["collab/z"].iloc[2] == f"{PAPER_TABLES['ycb'].ours_average[0]:.0f}"
+
+
+def test_each_planner_launches_as_one_hydra_multirun_into_the_job_directories():
+    bench = parse_args(["planner=random", "dataset=ycb", "mode=bin", "--noise", "10:0", "--n-jobs", "3"])
+    todo = [j for j in jobs(bench) if j.planner == "random"]
+    cmd = sweep_command(bench, todo)
+    assert cmd[1:4] == ["-m", "graspexp", "-m"]
+    assert "mode=bin" in cmd and "rot=z,xyz" in cmd and "dataset=ycb" in cmd
+    assert "perception.noise={trans_mm:0,rot_deg:0},{trans_mm:10,rot_deg:0}" in cmd
+    assert "hydra/launcher=joblib" in cmd and "hydra.launcher.n_jobs=3" in cmd
+    assert sorted(
+        Path(j.run_dir).relative_to(Path(bench.out) / "random" / "runs").as_posix() for j in todo
+    ) == [
+        "ycb/bin_xyz_t0_r0",
+        "ycb/bin_xyz_t10_r0",
+        "ycb/bin_z_t0_r0",
+        "ycb/bin_z_t10_r0",
+    ]
+    slurm = dataclasses.replace(bench, launcher="submitit", slurm_partition="gpu")
+    assert {"hydra/launcher=submitit_slurm", "hydra.launcher.partition=gpu"} <= set(
+        sweep_command(slurm, todo)
+    )
