@@ -15,9 +15,13 @@ def sweep_values(key: str, values: tuple[str, ...] | list[str]) -> str:
     return f"{key}={','.join(dict.fromkeys(values))}"
 
 
+PAPER_MODES: tuple[str, ...] = tuple(dict.fromkeys(m for m, _ in SETTINGS))
+"""The paper's modes in its column order: collab, bin."""
+PAPER_ROTS: tuple[str, ...] = tuple(dict.fromkeys(r for _, r in SETTINGS))
+"""The paper's drop rotations in its column order: z, xyz."""
 SETTINGS_SWEEP: tuple[str, ...] = (
-    sweep_values("mode", [m for m, _ in SETTINGS]),
-    sweep_values("rot", [r for _, r in SETTINGS]),
+    sweep_values("mode", PAPER_MODES),
+    sweep_values("rot", PAPER_ROTS),
 )
 """The paper's four settings (IV-C, IV-D) as multirun overrides: ``mode=collab,bin rot=z,xyz``."""
 PAPER_DATASETS: tuple[str, ...] = tuple(PAPER_TABLES)

@@ -56,6 +56,7 @@ from graspexp.report.paper import PAPER_TABLES, SETTINGS, TRIALS_PER_SETTING
 from graspexp.report.render import display_frame, footnotes, markdown
 from graspexp.report.stats import percentiles, success_pct
 from graspexp.report.tables import failure_breakdown, success_table
+from graspexp.run.suites import PAPER_MODES, PAPER_ROTS
 from graspexp.tools.cli import compose_checked, fail, tool_parser
 
 TRIAL_COLUMNS = (
@@ -170,9 +171,7 @@ def parse_args(argv: list[str]) -> Benchmark:
         raise ConfigError("planner is missing: python -m graspexp benchmark planner=NAME [dataset=...]")
     modes, rots = values.pop("mode", None), values.pop("rot", None)
     if modes or rots:  # every combination of the given modes and rotations, in the paper's order
-        paper_modes = list(dict.fromkeys(m for m, _ in SETTINGS))
-        paper_rots = list(dict.fromkeys(r for _, r in SETTINGS))
-        values["settings"] = [f"{m}/{r}" for m in (modes or paper_modes) for r in (rots or paper_rots)]
+        values["settings"] = [f"{m}/{r}" for m in (modes or PAPER_MODES) for r in (rots or PAPER_ROTS)]
     options = ("noise", "compare", "out", "n_jobs", "launcher", "slurm_partition", "timeout_min")
     return Benchmark(**values, **{k: getattr(args, k) for k in options if getattr(args, k) is not None})
 

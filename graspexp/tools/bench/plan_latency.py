@@ -38,12 +38,12 @@ from graspexp.planning import PlanRequest, kernels, plan  # noqa: E402
 from graspexp.planning.clusters import segment  # noqa: E402
 from graspexp.planning.cost import M_TO_MM  # noqa: E402
 from graspexp.planning.optimal import kmeans_random_state, paper_candidates, path_costs  # noqa: E402
+from graspexp.run.suites import PAPER_MODES  # noqa: E402
 from graspexp.run.upright import upright_request  # noqa: E402
 from graspexp.tools.cli import compose_checked, fail, tool_parser  # noqa: E402
 
 PAPER_PLAN_S = 0.1
 """The paper's planner time (clusters + paths + cost), seconds (IV-F, i7-9700)."""
-MODES = ("collab", "bin")
 WARMUP_RUNS = 3
 TARGET_P50_CPU_MS = 2.5
 """The target for the CPU-time p50 of each object and mode, one thread, ms (issue 15)."""
@@ -142,7 +142,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             model = job_object(cfg, name)
         except DatasetError as err:
             fail(str(err), prog)
-        for mode in MODES:
+        for mode in PAPER_MODES:
             cfg.mode.name = mode
             req = upright_request(cfg, model)
             if first is None:

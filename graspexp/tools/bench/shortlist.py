@@ -33,8 +33,7 @@ from graspexp.planning import plan
 from graspexp.planning.optimal_plus import pick_shortlisted
 from graspexp.planning.request import PlanResult
 from graspexp.quality import fc_min_mu
-from graspexp.report.paper import SETTINGS
-from graspexp.run.suites import PAPER_DATASETS
+from graspexp.run.suites import PAPER_DATASETS, PAPER_MODES, PAPER_ROTS
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
 from graspexp.tools.cli import compose_checked, fail, take_sweep, tool_parser
@@ -165,8 +164,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.n_jobs < 1:
         fail(f"--n-jobs {args.n_jobs} is invalid: expected 1 or more processes", PROG)
     datasets, rest = take_sweep(args.overrides, "dataset", PAPER_DATASETS)
-    modes, rest = take_sweep(rest, "mode", dict.fromkeys(m for m, _ in SETTINGS))
-    rots, rest = take_sweep(rest, "rot", dict.fromkeys(r for _, r in SETTINGS))
+    modes, rest = take_sweep(rest, "mode", PAPER_MODES)
+    rots, rest = take_sweep(rest, "rot", PAPER_ROTS)
     trials, rest = take_sweep(rest, "trials", ["5"])
     if len(trials) != 1 or not trials[0].isdigit() or int(trials[0]) < 1:
         fail(f"trials={','.join(trials)} is invalid: expected one positive integer", PROG)

@@ -29,6 +29,7 @@ from graspexp.planning import plan
 from graspexp.quality import fc_min_mu
 from graspexp.record import TrialRecorder
 from graspexp.record.scene import object_scene
+from graspexp.run.suites import PAPER_MODES
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
 from graspexp.tools.cli import compose_checked, take_sweep, tool_parser
@@ -196,7 +197,7 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--repeats", type=int, default=3, help="repeats of the throughput runs (0: skip them)")
     args = ap.parse_intermixed_args(argv)
     threadpool_limits(limits=1)
-    modes, rest = take_sweep(args.overrides, "mode", ["collab", "bin"])
+    modes, rest = take_sweep(args.overrides, "mode", PAPER_MODES)
     cfg = compose_checked([*rest, f"mode={modes[0]}"], ap.prog)
     names = list(cfg.objects) if cfg.objects else available_objects(cfg.dataset)
     trials = int(cfg.trials)
