@@ -294,7 +294,6 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
         "--base-url", default=None, help="base URL of the archives (default: env or official)"
     )
     parser.add_argument("--sha256", default=None, help="expected SHA-256 of lm_models.zip (mirrors)")
-    parser.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     args = parser.parse_intermixed_args(argv)
     cfg = compose_checked(args.overrides, PROG)
     args.dataset = str(cfg.dataset.name)
@@ -302,6 +301,7 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
         valid = [n for n, spec in DATASETS.items() if spec.downloadable]
         parser.error(f"dataset={args.dataset} cannot be downloaded; give dataset= one of {', '.join(valid)}")
     args.root = resolve_root(cfg.dataset)
+    args.progress = bool(cfg.progress)
     catalogue = dataset_spec(args.dataset).catalogue
     objects = list(catalogue) if args.all else list(cfg.objects or cfg.dataset.objects or [])
     args.objects_given = bool(objects)
@@ -315,7 +315,7 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
 def main(argv: Sequence[str] | None = None) -> int:
     """CLI entry point; returns the exit status (2 for a dataset error, with one message on stderr)."""
     args = parse_args(argv)
-    progress = not args.no_progress
+    progress = args.progress
     try:
         if args.dataset == "ycb":
             paths = download_ycb(args.root, args.objects, url=args.base_url, progress=progress)

@@ -131,7 +131,8 @@ def test_figures_cli_writes_the_pngs(tmp_path, planner):
 
 
 def test_plan_latency_bench_prints_a_row_per_object_and_mode(capsys):
-    from graspexp.tools.bench.plan_latency import MODES, main
+    from graspexp.run.suites import PAPER_MODES as MODES
+    from graspexp.tools.bench.plan_latency import main
 
     assert main(["--repeats", "2", "--runs", "2", "dataset=primitives", "planner.m=64"]) == 0
     out = capsys.readouterr().out.splitlines()

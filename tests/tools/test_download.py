@@ -109,7 +109,7 @@ def test_ycb_download_records_hash_and_loads(server, tmp_path, capsys):
     folder, url, log = server
     archive = ycb_archive(folder)
     root = tmp_path / "data"
-    argv = ["dataset=ycb", f"dataset.root={root}", f"objects=[{YCB_ID}]", "--base-url", url, "--no-progress"]
+    argv = ["dataset=ycb", f"dataset.root={root}", f"objects=[{YCB_ID}]", "--base-url", url, "progress=false"]
     assert download.main(argv) == 0
     assert (root / "ycb" / YCB_ID / "google_16k" / "textured.obj").is_file()
     registry = json.loads((root / download.HASH_REGISTRY).read_text())
@@ -138,7 +138,7 @@ def test_ycb_tampered_archive_fails_clearly(server, tmp_path, capsys):
 
     ycb_archive(folder, size=0.07)  # the server now serves different bytes under the same name
     (root / download.ARCHIVE_DIR / f"{YCB_ID}_google_16k.tgz").unlink()  # e.g. a fresh machine, same root
-    argv = ["dataset=ycb", f"dataset.root={root}", f"objects=[{YCB_ID}]", "--base-url", url, "--no-progress"]
+    argv = ["dataset=ycb", f"dataset.root={root}", f"objects=[{YCB_ID}]", "--base-url", url, "progress=false"]
     assert download.main(argv) == 2
     err = capsys.readouterr().err
     assert err.startswith(
@@ -165,7 +165,9 @@ def test_linemod_wrong_hash_fails_clearly(server, tmp_path, capsys):
     folder, url, _ = server
     linemod_archive(folder)  # not the published archive, so the published SHA-256 cannot match
     root = tmp_path / "data"
-    assert download.main(["dataset=linemod", f"dataset.root={root}", "--base-url", url, "--no-progress"]) == 2
+    assert (
+        download.main(["dataset=linemod", f"dataset.root={root}", "--base-url", url, "progress=false"]) == 2
+    )
     err = capsys.readouterr().err
     assert "checksum mismatch for " + url + download.LINEMOD_ARCHIVE in err
     assert download.LINEMOD_SHA256 in err
@@ -177,7 +179,7 @@ def test_base_url_from_environment(server, tmp_path, monkeypatch, capsys):
     digest = hashlib.sha256(linemod_archive(folder).read_bytes()).hexdigest()
     monkeypatch.setenv("GRASPEXP_LINEMOD_URL", url.rstrip("/"))
     root = tmp_path / "data"
-    argv = ["dataset=linemod", f"dataset.root={root}", f"--sha256={digest}", "--no-progress"]
+    argv = ["dataset=linemod", f"dataset.root={root}", f"--sha256={digest}", "progress=false"]
     assert download.main(argv) == 0  # the default list: the 12 models this archive lacks are a warning
     assert "lacks the models of: benchvise" in capsys.readouterr().err
     assert log == ["/" + download.LINEMOD_ARCHIVE]
@@ -270,7 +272,7 @@ def test_interrupted_download_leaves_no_temporary_file(server, tmp_path, sig):
     threading.Thread(target=httpd.serve_forever, daemon=True).start()
     root = tmp_path / "data"
     cmd = [sys.executable, "-m", "graspexp", "download", "dataset=ycb", f"dataset.root={root}", f"objects=[{YCB_ID}]",
-           "--base-url", f"http://127.0.0.1:{httpd.server_address[1]}/", "--no-progress"]  # fmt: skip
+           "--base-url", f"http://127.0.0.1:{httpd.server_address[1]}/", "progress=false"]  # fmt: skip
     log = tmp_path / "download.log"
     with open(log, "w") as err:
         proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=err)
