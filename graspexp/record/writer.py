@@ -305,6 +305,17 @@ class TrialWriter:
         self.finish()
 
 
+def is_write_error(exc: BaseException) -> bool:
+    """Whether ``exc`` is a failure to write a log file: an OSError, or the Foxglove SDK's RuntimeError
+    for an I/O error of its MCAP sink (a full disk, a file-size limit)."""
+    text = str(exc)
+    return isinstance(exc, OSError) or (
+        isinstance(exc, RuntimeError)
+        and "FoxgloveError" in text
+        and ("I/O error" in text or "write method failed" in text)
+    )
+
+
 class TrialRecorder(TrialWriter):
     """Atomic trial log file; use as a context manager.
 
@@ -345,11 +356,18 @@ class TrialRecorder(TrialWriter):
     def abort(self) -> None:
         """Discard the log: close and delete the partial file; nothing is left at ``path``."""
         mcap, self._mcap, self._finished = getattr(self, "_mcap", None), None, True
-        if mcap is not None:
-            mcap.close()  # detaches the file from the channels (a live server's stay in use)
-        if not self._file.closed:
-            self._file.close()
-        self.partial_path.unlink(missing_ok=True)
+        try:
+            if mcap is not None:
+                mcap.close()  # detaches the file from the channels (a live server's stay in use)
+        except Exception as exc:  # a sink that failed to write (disk full) fails to close too
+            if not is_write_error(exc):
+                raise
+        finally:
+            try:
+                self._file.close()  # flushes: fails again on a full disk
+            except OSError:
+                pass  # the partial file is discarded below either way
+            self.partial_path.unlink(missing_ok=True)
 
     def __enter__(self) -> "TrialRecorder":
         return self

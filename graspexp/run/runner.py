@@ -49,6 +49,7 @@ from graspexp.record import (
     trial_recorder,
 )
 from graspexp.record.scene import ObjectScene, object_scene
+from graspexp.record.writer import is_write_error
 from graspexp.run.prepare import prepare_shapes
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import TrialContext, plain_config, run_trial
@@ -163,14 +164,20 @@ def run_object_trials(
                                 plain, model, hulls, i, seed, rec, scene, plan=plan, quality=fc_min_mu
                             )
                         )
-                    except OSError:
-                        raise
                     except Exception as exc:  # one trial's error is recorded; the sweep goes on
+                        if is_write_error(exc):
+                            raise
                         log.error("%s trial %d failed with an error: %s", object_name, i, exc)
                         result = _error_result(cfg, object_name, i, seed, exc)
                         rec.result(0.0, result.to_dict())
-            except OSError as exc:
-                raise RunError(f"cannot write the trial log {path}: {exc.strerror or exc}") from None
+            except Exception as exc:
+                if not is_write_error(exc):
+                    raise
+                why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+                raise RunError(
+                    f"cannot write the trial log {path}: {why}; the disk may be full: free space, then run "
+                    "the same command again (finished trials are kept and reused)"
+                ) from None
         results.append(result)
         if bar is not None:
             bar.set_postfix_str(f"{object_name} #{i}: {'ok' if result.success else result.reason}")

@@ -1,0 +1,44 @@
+"""A run that cannot write its logs (a full disk; here a file-size limit, which fails the same writes):
+one error line naming the fix, exit status 2, no partial file left; the same command then resumes."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+pytestmark = [pytest.mark.sim, pytest.mark.slow]
+REPO = Path(__file__).resolve().parents[2]
+LIMITED = """
+import resource, runpy, signal, sys
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # a write past the limit fails with EFBIG instead
+resource.setrlimit(resource.RLIMIT_FSIZE, (30_000, 30_000))
+sys.argv = ["graspexp", *sys.argv[1:]]
+runpy.run_module("graspexp", run_name="__main__")
+"""
+JOB = ["objects=[can]", "trials=2", "progress=false"]
+
+
+def _run(*args: str, limited: bool = False) -> subprocess.CompletedProcess:
+    cmd = [sys.executable, "-c", LIMITED, *args] if limited else [sys.executable, "-m", "graspexp", *args]
+    return subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, timeout=300)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_FSIZE and SIGXFSZ")
+def test_a_full_disk_is_one_line_and_the_run_resumes(tmp_path):
+    run_dir = tmp_path / "run"
+    full = _run(*JOB, f"hydra.run.dir={run_dir}", limited=True)
+    assert full.returncode == 2, full.stderr[-2000:]
+    lines = full.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in full.stderr
+    assert lines[0].startswith("graspexp: error: cannot write the trial log ")
+    assert "free space, then run the same command again" in lines[0]
+    assert not list(run_dir.rglob("*.partial"))
+    again = _run(*JOB, f"hydra.run.dir={run_dir}")
+    assert again.returncode == 0, again.stderr[-2000:]
+    clean = _run(*JOB, f"hydra.run.dir={tmp_path / 'clean'}")
+    assert clean.returncode == 0, clean.stderr[-2000:]
+    keys = ["object", "trial", "seed", "success", "reason", "slip_m", "steps"]
+    resumed, reference = (pd.read_csv(d / "results.csv")[keys] for d in (run_dir, tmp_path / "clean"))
+    pd.testing.assert_frame_equal(resumed, reference)
