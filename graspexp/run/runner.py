@@ -15,6 +15,7 @@ With ``record=false`` no log is written (faster, but nothing to replay and nothi
 
 import dataclasses
 import datetime
+import errno
 import logging
 import os
 import platform
@@ -85,6 +86,10 @@ def package_versions() -> dict[str, str]:
         except PackageNotFoundError:
             out[name] = "unknown"
     return out
+
+
+NO_SPACE_ERRNOS = (errno.ENOSPC, errno.EFBIG, errno.EDQUOT)
+"""Write errors that mean no room is left (a full disk or quota, a file-size limit)."""
 
 
 class RunError(RuntimeError):
@@ -174,10 +179,14 @@ def run_object_trials(
                 if not is_write_error(exc):
                     raise
                 why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-                raise RunError(
-                    f"cannot write the trial log {path}: {why}; the disk may be full: free space, then run "
-                    "the same command again (finished trials are kept and reused)"
-                ) from None
+                full = not isinstance(exc, OSError) or exc.errno in NO_SPACE_ERRNOS
+                hint = (
+                    "; the disk may be full: free space, then run the same command again (finished "
+                    "trials are kept and reused)"
+                    if full
+                    else ""
+                )
+                raise RunError(f"cannot write the trial log {path}: {why}{hint}") from None
         results.append(result)
         if bar is not None:
             bar.set_postfix_str(f"{object_name} #{i}: {'ok' if result.success else result.reason}")
