@@ -1,6 +1,8 @@
 """The object model every later stage consumes."""
 
+import hashlib
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import trimesh
@@ -28,6 +30,14 @@ class ObjectModel:
     area_mask: np.ndarray
     mass_kg: float
     source: str = ""
+
+    @cached_property
+    def mesh_sha256(self) -> str:
+        """SHA-256 of the geometry every trial uses (vertices in metres as float64, faces as int64, after
+        loading, scaling and merging): the same file at another scale or another file hashes differently."""
+        digest = hashlib.sha256(np.ascontiguousarray(self.mesh.vertices, dtype=np.float64).tobytes())
+        digest.update(np.ascontiguousarray(self.mesh.faces, dtype=np.int64).tobytes())
+        return digest.hexdigest()
 
     @property
     def area_points(self) -> np.ndarray:

@@ -396,21 +396,26 @@ def read_result(path: Path | str) -> dict:
     return result
 
 
-def read_config_yaml(path: Path | str) -> str | None:
-    """The job config recorded in a log's ``graspexp`` metadata record (YAML text), None when the record
-    holds none; :class:`CorruptLogError` when the file's metadata cannot be read. Reads the summary's
-    metadata index only: the fast path beside :func:`read_result`."""
+def read_metadata(path: Path | str) -> dict[str, str] | None:
+    """A log's ``graspexp`` metadata record (config, seeds, mesh, versions), None when it has none;
+    :class:`CorruptLogError` when the file's metadata cannot be read. Reads the summary's metadata index
+    only: the fast path beside :func:`read_result`."""
     name = str(path)
     try:
         with open(path, "rb") as f:
             for record in SeekingReader(f).iter_metadata():
                 if record.name == S.METADATA_NAME:
-                    return record.metadata.get("config_yaml")
+                    return dict(record.metadata)
     except OSError:
         raise
     except Exception as exc:  # any parse failure of the file
         raise CorruptLogError(f"{name}: unreadable metadata ({type(exc).__name__}: {exc})") from exc
     return None
+
+
+def read_config_yaml(path: Path | str) -> str | None:
+    """The job config recorded in a log's metadata (YAML text; :func:`read_metadata`), None without one."""
+    return (read_metadata(path) or {}).get("config_yaml")
 
 
 def _trial_sort_key(p: Path) -> tuple:

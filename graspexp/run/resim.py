@@ -53,6 +53,13 @@ def resimulate(log) -> tuple[bool, str]:
     )
     logged = log.result or {}
     problems = []
+    recorded = meta.get("mesh_sha256")
+    if recorded is not None and recorded != model.mesh_sha256:
+        problems.append(
+            f"mesh differs: the log was made on {meta.get('mesh_source') or 'a procedural mesh'} (sha256 "
+            f"{recorded[:12]}), this data root gives {model.source or 'a procedural mesh'} (sha256 "
+            f"{model.mesh_sha256[:12]})"
+        )
     if bool(logged.get("success")) != result.success or logged.get("reason") != result.reason:
         problems.append(
             f"outcome differs: logged success={logged.get('success')} reason={logged.get('reason')}, "

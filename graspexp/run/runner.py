@@ -49,6 +49,7 @@ from graspexp.record import (
     trial_log_path,
     trial_recorder,
 )
+from graspexp.record.reader import read_metadata
 from graspexp.record.scene import ObjectScene, object_scene
 from graspexp.record.writer import is_write_error
 from graspexp.run.prepare import prepare_shapes
@@ -104,8 +105,38 @@ def job_metadata(cfg: DictConfig) -> dict[str, str]:
     return meta
 
 
-def _metadata(job_meta: dict[str, str], object_name: str, trial: int, seed: int) -> dict[str, str]:
-    return {**job_meta, "object": object_name, "trial": str(trial), "trial_seed": str(seed)}
+def _metadata(job_meta: dict[str, str], model: ObjectModel, trial: int, seed: int) -> dict[str, str]:
+    """One trial's log metadata: the job's, the trial's seeds and what its object was made of (the mesh
+    file, "" for a procedural one, and the SHA-256 of the geometry used)."""
+    return {
+        **job_meta,
+        "object": model.name,
+        "trial": str(trial),
+        "trial_seed": str(seed),
+        "mesh_source": model.source,
+        "mesh_sha256": model.mesh_sha256,
+    }
+
+
+def check_same_meshes(run_dir: Path, models: dict[str, ObjectModel]) -> None:
+    """Raise RunError if a log in ``run_dir`` was made on another geometry of its object than this run
+    loads (another data root, a re-download, a rescaled file): resume never mixes trials of two meshes.
+    Logs that record no mesh (written before graspexp recorded it) and unreadable ones are not compared."""
+    for path in iter_trial_logs(run_dir):
+        try:
+            meta = read_metadata(path) or {}
+        except CorruptLogError:
+            continue
+        model = models.get(meta.get("object", ""))
+        logged = meta.get("mesh_sha256")
+        if model is None or logged is None or logged == model.mesh_sha256:
+            continue
+        raise RunError(
+            f"{run_dir} holds trials of {model.name} made on another mesh ({path.relative_to(run_dir)}: "
+            f"{meta.get('mesh_source') or 'procedural'}, sha256 {logged[:12]}; now "
+            f"{model.source or 'procedural'}, sha256 {model.mesh_sha256[:12]}); resume only reuses trials "
+            f"of the same mesh: choose another output directory or delete {run_dir / 'trials'}"
+        )
 
 
 def _error_result(
@@ -160,7 +191,7 @@ def run_object_trials(
         if result is None:
             try:
                 path.parent.mkdir(parents=True, exist_ok=True)
-                meta = _metadata(job_meta, object_name, i, seed)
+                meta = _metadata(job_meta, model, i, seed)
                 recorder = trial_recorder(path if cfg.record else None, meta, plain)
                 with recorder as rec:
                     try:
@@ -346,6 +377,7 @@ def _run(cfg: DictConfig, run_dir: Path) -> float:
     check_resumable(cfg, run_dir)
     prepare_shapes(cfg.dataset, cfg.sim, objects, cfg.progress)
     models = load_models(cfg, objects)
+    check_same_meshes(run_dir, {name: loaded[0] for name, loaded in models.items()})
     results: list[TrialResult] = []
     with tqdm(
         total=len(objects) * cfg.trials,
