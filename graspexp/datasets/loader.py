@@ -21,6 +21,7 @@ from graspexp.datasets.catalog import (
     check_object_name,
     dataset_dir,
     dataset_objects,
+    dataset_spec,
     mesh_path,
     resolve_root,
 )
@@ -180,15 +181,18 @@ def job_object(job: Any, name: str) -> ObjectModel:
 
 
 def select_objects(dataset: Any, objects: list[str] | None) -> list[str]:
-    """The objects to run: ``objects`` if given (each must exist), else the dataset's list less the objects
-    whose files are missing (named in a warning with the download command). ``dataset``: the job's
-    ``dataset`` config."""
-    names = dataset_objects(dataset)
+    """The objects to run: ``objects`` if given (each must be in the dataset's catalogue, not only in its
+    default list), else the dataset's list less the objects whose files are missing (named in a warning
+    with the download command). ``dataset``: the job's ``dataset`` config."""
     if objects:
-        unknown = [o for o in objects if o not in names]
+        catalogue = dataset_spec(dataset.name).catalogue
+        unknown = [o for o in objects if o not in catalogue]
         if unknown:
-            raise DatasetError(f"unknown object(s) {unknown} in dataset {dataset.name!r}; valid: {names}")
+            raise DatasetError(
+                f"unknown object(s) {unknown} in dataset {dataset.name!r}; valid: {', '.join(catalogue)}"
+            )
         return list(objects)
+    names = dataset_objects(dataset)
     present = available_objects(dataset)
     if not present:
         load_object(dataset, names[0], 16, 0)  # raises the DatasetError that names the missing path

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import trimesh
 import yaml
+from conftest import compose_cfg
 from omegaconf import OmegaConf
 
 from graspexp.config import DatasetConfig
@@ -21,7 +22,7 @@ from graspexp.datasets import (
     primitives,
     resolve_root,
 )
-from graspexp.datasets.catalog import DATASETS, YCB_MASS_KG
+from graspexp.datasets.catalog import DATASETS, YCB_MASS_KG, dataset_spec
 from graspexp.datasets.loader import _load_mesh_cached
 
 REPO = Path(__file__).resolve().parents[2]
@@ -271,3 +272,13 @@ def test_primitive_objects_load_without_data(monkeypatch, tmp_path):
     block = load_object(cfg, "block", 128, 0)
     assert block.mass_kg == pytest.approx(0.085 * 0.085 * 0.2 * 500.0)
     assert block.source == ""
+
+
+def test_any_catalogue_object_can_be_selected_not_only_the_default_list():
+    from graspexp.datasets import select_objects
+
+    ycb = compose_cfg("dataset=ycb").dataset
+    assert "002_master_chef_can" not in ycb.objects and "002_master_chef_can" in dataset_spec("ycb").catalogue
+    assert select_objects(ycb, ["002_master_chef_can", "025_mug"]) == ["002_master_chef_can", "025_mug"]
+    with pytest.raises(DatasetError, match=r"unknown object\(s\) \['teapot'\] in dataset 'ycb'; valid: 002_"):
+        select_objects(ycb, ["teapot"])
