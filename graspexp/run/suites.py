@@ -1,7 +1,8 @@
 """Every job matrix graspexp runs, built from the one statement of the paper's settings
 (:mod:`graspexp.report.paper`): the paper suite (its four settings x Tables 1 and 2 x 10 trials), the
-readings (each way to read the paper, the other planners, optimal_plus's ablations), as Hydra multirun
-overrides. The tools and ``nox`` sessions launch them with Hydra (``python -m graspexp -m ...``)."""
+readings (each way to read the paper, the other planners, optimal_plus's ablations) and the benchmark's
+standard suite (every planner x dataset x setting x pose-noise level), as Hydra multirun overrides or
+job lists. The tools and ``nox`` sessions launch them with Hydra (``python -m graspexp -m ...``)."""
 
 import sys
 from dataclasses import dataclass
@@ -219,6 +220,67 @@ def reading_sweep(reading: Reading, out: Path, overrides: tuple[str, ...] | list
         *reading.overrides,
         *overrides,
     ]
+
+
+NOISE_LEVELS: tuple[tuple[float, float], ...] = ((10.0, 0.0), (20.0, 0.0), (0.0, 10.0))
+"""Pose-noise levels (translation std mm, rotation std degrees) run besides zero, as in ``nox -s compare``."""
+
+
+@dataclass(frozen=True)
+class Job:
+    """One job of the benchmark suite: its planner, dataset, setting and noise level, its overrides and
+    the directory it runs into."""
+
+    planner: str
+    dataset: str
+    mode: str
+    rot: str
+    trans_mm: float
+    rot_deg: float
+    overrides: tuple[str, ...]
+    run_dir: str
+
+
+def benchmark_suite(
+    planners: list[str],
+    datasets: list[str],
+    settings: list[str],
+    levels: list[tuple[float, float]],
+    trials: int,
+    objects: list[str] | None,
+    overrides: list[str],
+    out: Path,
+) -> list[Job]:
+    """The benchmark's job matrix: every planner (the first is the entered one) x dataset x ``mode/rot``
+    setting x pose-noise level (mm, degrees; zero first, then ``levels``), each into
+    ``out/<planner>/runs/<dataset>/<mode>_<rot>_t<mm>_r<deg>``. ``planner.*`` overrides go to the first
+    planner only, the others to every job."""
+    shared = [o for o in overrides if not o.lstrip("+~").startswith("planner.")]
+    own = [o for o in overrides if o.lstrip("+~").startswith("planner.")]
+    levels = [(0.0, 0.0)] + [(t, r) for t, r in levels if (t, r) != (0, 0)]
+    subset = [f"objects=[{','.join(objects)}]"] if objects else []
+    jobs = []
+    for planner in planners:
+        for dataset in datasets:
+            for setting in settings:
+                mode, rot = setting.split("/")
+                for t, r in levels:
+                    job_overrides = (
+                        f"planner={planner}",
+                        f"dataset={dataset}",
+                        f"mode={mode}",
+                        f"rot={rot}",
+                        f"perception.noise.trans_mm={t}",
+                        f"perception.noise.rot_deg={r}",
+                        f"trials={trials}",
+                        "progress=false",
+                        *subset,
+                        *shared,
+                        *(own if planner == planners[0] else []),
+                    )
+                    run_dir = out / planner / "runs" / dataset / f"{mode}_{rot}_t{t:g}_r{r:g}"
+                    jobs.append(Job(planner, dataset, mode, rot, t, r, job_overrides, str(run_dir)))
+    return jobs
 
 
 if __name__ == "__main__":  # the paper suite's overrides, for scripts: python -m graspexp.run.suites [TRIALS]

@@ -56,7 +56,7 @@ from graspexp.report.paper import PAPER_TABLES, SETTINGS, TRIALS_PER_SETTING
 from graspexp.report.render import display_frame, footnotes, markdown
 from graspexp.report.stats import percentiles, success_pct
 from graspexp.report.tables import failure_breakdown, success_table
-from graspexp.run.suites import PAPER_MODES, PAPER_ROTS
+from graspexp.run.suites import NOISE_LEVELS, PAPER_MODES, PAPER_ROTS, Job, benchmark_suite
 from graspexp.tools.cli import compose_checked, fail, tool_parser
 
 TRIAL_COLUMNS = (
@@ -76,8 +76,6 @@ TRIAL_COLUMNS = (
     "plan_ms",
 )
 """Columns of ``trials.csv``: one row per trial, with its in-area contact fraction beside its outcome."""
-NOISE_LEVELS: tuple[tuple[float, float], ...] = ((10.0, 0.0), (20.0, 0.0), (0.0, 10.0))
-"""Pose-noise levels (translation std mm, rotation std degrees) run besides zero, as in ``nox -s compare``."""
 IN_AREA_NOTE = (
     "In-area contact %: share of the finger-object contacts at the end of closing that lie within "
     f"{IN_AREA_TOLERANCE_M * 1000:g} mm of a grasping-area point of the object's reference cloud "
@@ -104,18 +102,6 @@ class Benchmark:
     slurm_partition: str = ""
     timeout_min: int = 240
     overrides: list[str] = field(default_factory=list)
-
-
-@dataclass(frozen=True)
-class Job:
-    planner: str
-    dataset: str
-    mode: str
-    rot: str
-    trans_mm: float
-    rot_deg: float
-    overrides: tuple[str, ...]
-    run_dir: str
 
 
 PROG = "graspexp benchmark"
@@ -189,33 +175,18 @@ def compared(bench: Benchmark) -> list[str]:
 
 
 def jobs(bench: Benchmark) -> list[Job]:
-    """Every (planner, dataset, setting, noise level) job of the suite, entered planner first."""
-    shared = [o for o in bench.overrides if not o.lstrip("+~").startswith("planner.")]
-    own = [o for o in bench.overrides if o.lstrip("+~").startswith("planner.")]
-    levels = [(0.0, 0.0)] + [(float(t), float(r)) for t, r in bench.noise if (t, r) != (0, 0)]
-    objects = [f"objects=[{','.join(bench.objects)}]"] if bench.objects else []
-    out = []
-    for planner in [bench.planner, *compared(bench)]:
-        for dataset in bench.datasets:
-            for setting in bench.settings:
-                mode, rot = setting.split("/")
-                for t, r in levels:
-                    overrides = (
-                        f"planner={planner}",
-                        f"dataset={dataset}",
-                        f"mode={mode}",
-                        f"rot={rot}",
-                        f"perception.noise.trans_mm={t}",
-                        f"perception.noise.rot_deg={r}",
-                        f"trials={bench.trials}",
-                        "progress=false",
-                        *objects,
-                        *shared,
-                        *(own if planner == bench.planner else []),
-                    )
-                    run_dir = Path(bench.out) / planner / "runs" / dataset / f"{mode}_{rot}_t{t:g}_r{r:g}"
-                    out.append(Job(planner, dataset, mode, rot, t, r, overrides, str(run_dir)))
-    return out
+    """Every (planner, dataset, setting, noise level) job of the suite, entered planner first
+    (:func:`graspexp.run.suites.benchmark_suite`)."""
+    return benchmark_suite(
+        [bench.planner, *compared(bench)],
+        bench.datasets,
+        bench.settings,
+        [(float(t), float(r)) for t, r in bench.noise],
+        bench.trials,
+        bench.objects,
+        bench.overrides,
+        Path(bench.out),
+    )
 
 
 RUN_SUBDIR = (

@@ -8,7 +8,8 @@ import pytest
 
 from graspexp.config import ConfigError
 from graspexp.report.paper import PAPER_TABLES, SETTINGS
-from graspexp.tools.benchmark import NOISE_LEVELS, compared, jobs, parse_args, ranking, sweep_command
+from graspexp.run.suites import NOISE_LEVELS
+from graspexp.tools.benchmark import compared, jobs, parse_args, ranking, sweep_command
 
 
 def test_standard_suite_is_four_settings_on_both_tables_at_every_noise_level_for_every_planner():
