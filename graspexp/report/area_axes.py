@@ -14,7 +14,8 @@ from graspexp.core.seeding import cloud_seed
 from graspexp.datasets import DatasetError, load_object
 from graspexp.planning.clusters import elongation, main_axis
 from graspexp.planning.optimal import pose_axis_source
-from graspexp.record import CorruptLogError, read_trial
+from graspexp.record import CorruptLogError
+from graspexp.record.reader import read_config_yaml
 
 
 def area_axes_frame(results: pd.DataFrame) -> pd.DataFrame:
@@ -24,9 +25,12 @@ def area_axes_frame(results: pd.DataFrame) -> pd.DataFrame:
     rows = []
     for (dataset, obj), sub in results.groupby(["dataset", "object"], sort=False):
         try:
-            cfg = OmegaConf.create(read_trial(sub["path"].iloc[0]).metadata["config_yaml"])
-        except (CorruptLogError, OSError, KeyError):
+            text = read_config_yaml(sub["path"].iloc[0])
+        except (CorruptLogError, OSError):
             continue
+        if text is None:
+            continue
+        cfg = OmegaConf.create(text)
         if "pose_axis" not in cfg.planner:
             return pd.DataFrame()
         ds = OmegaConf.merge(OmegaConf.structured(DatasetConfig), cfg.dataset)

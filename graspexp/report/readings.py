@@ -45,18 +45,17 @@ def _results(name: str, root: Path, in_area: bool = False) -> pd.DataFrame:
     return df
 
 
-def readings_frame(entries: dict[str, tuple[Path, str]]) -> tuple[pd.DataFrame, pd.DataFrame]:
+def readings_frame(results: dict[str, tuple[pd.DataFrame, str]]) -> tuple[pd.DataFrame, pd.DataFrame]:
     """(averages, per-object) long tables from the reading directories.
 
-    entries : name -> (directory, one-line description). averages: one row per (reading, dataset, mode,
+    results : name -> (the reading's results, :func:`_results`, one-line description). averages: one row per (reading, dataset, mode,
     rot) with n, successes, ours_pct, lo_pct, hi_pct (Wilson 95 %, pooled trials), paper_pct (the
     paper's printed average), paper_same_pct (the paper's mean over the objects run) and in_area_pct
     (held with every finger contact in the grasping area, %; nan without logs).
     per-object: one row per (reading, dataset, object, mode, rot) with n and ours_pct.
     """
     avg_rows, obj_rows = [], []
-    for name, (root, what) in entries.items():
-        df = _results(name, root, in_area=True)
+    for name, (df, what) in results.items():
         if df.empty:
             continue
         planner = str(df["planner"].iloc[0])
@@ -163,7 +162,8 @@ def readings_report(entries: dict[str, tuple[Path, str]], out_dir: Path | str) -
     """Write ``readings.md``, ``readings.csv`` and ``ceiling.csv`` into ``out_dir``; returns the Markdown."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    avg, per_obj = readings_frame(entries)
+    results = {n: (_results(n, root, in_area=True), what) for n, (root, what) in entries.items()}
+    avg, per_obj = readings_frame(results)
     if avg.empty:
         text = "# Readings\n\nNo trial logs in the reading directories.\n"
         (out / "readings.md").write_text(text)
@@ -190,18 +190,16 @@ def readings_report(entries: dict[str, tuple[Path, str]], out_dir: Path | str) -
             _ceiling_markdown(ceil, dataset),
             "",
         ]
-    md += _area_axes_section(entries, out)
+    if "default" in results:
+        md += _area_axes_section(results["default"][0], out)
     text = "\n".join(md)
     (out / "readings.md").write_text(text)
     return text
 
 
-def _area_axes_section(entries: dict[str, tuple[Path, str]], out: Path) -> list[str]:
-    """Per object of the ``default`` reading's logs: the area's elongation and the axis ``pose_axis``
-    took (``area_axes.csv``); nothing without logs."""
-    if "default" not in entries:
-        return []
-    df = _results("default", entries["default"][0])
+def _area_axes_section(df: pd.DataFrame, out: Path) -> list[str]:
+    """Per object of the ``default`` reading's results ``df``: the area's elongation and the axis
+    ``pose_axis`` took (``area_axes.csv``); nothing without logs."""
     frame = area_axes_frame(df[df["path"] != ""]) if not df.empty else pd.DataFrame()
     if frame.empty:
         return []
