@@ -19,6 +19,8 @@ BASE_PACKAGE = "core"
 """Modules every stage may import (geometry, seeding, outcome, body names): they import no stage."""
 TOOLS_PACKAGE = "tools"
 """Command-line tools: thin ``main(argv)`` functions above every stage; no stage imports them."""
+TOOL_ALIASES = ("area",)
+"""Packages that only give a tool its own ``python -m graspexp.<name>``: they count as tools."""
 
 
 def _module_name(path: Path) -> str:
@@ -55,7 +57,7 @@ def _kind(module: str) -> str:
         return "entry"
     if parts[1] == BASE_PACKAGE:
         return "base"
-    if parts[1] == TOOLS_PACKAGE:
+    if parts[1] in (TOOLS_PACKAGE, *TOOL_ALIASES):
         return "tool"
     return f"stage:{STAGE_OF_PACKAGE[parts[1]]}"
 
@@ -64,7 +66,7 @@ def test_top_level_holds_only_packages_and_the_entry_point():
     modules = sorted(p.name for p in PACKAGE.glob("*.py"))
     assert modules == ["__init__.py", "__main__.py"], modules
     packages = {p.name for p in PACKAGE.iterdir() if (p / "__init__.py").is_file()}
-    assert packages == {*STAGE_OF_PACKAGE, BASE_PACKAGE, TOOLS_PACKAGE}, packages
+    assert packages == {*STAGE_OF_PACKAGE, BASE_PACKAGE, TOOLS_PACKAGE, *TOOL_ALIASES}, packages
 
 
 def test_stages_import_one_way():

@@ -9,6 +9,7 @@ that the error message prints.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -84,6 +85,20 @@ class Text:
 
     def __str__(self) -> str:
         return "a non-empty string"
+
+
+@dataclass(frozen=True)
+class Pattern:
+    """A string that matches a regular expression (``what`` says it in words)."""
+
+    regex: str
+    what: str
+
+    def accepts(self, v: object) -> bool:
+        return isinstance(v, str) and re.fullmatch(self.regex, v) is not None
+
+    def __str__(self) -> str:
+        return self.what
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,12 @@
-"""What exists: object names, file layouts, published masses and where the data root is.
+"""What exists: the layouts, their object names, file paths, published facts and where the data root is.
+
+Four layouts (``dataset.layout``; None takes the catalogued set's own):
+
+- ``ycb``: ``<id>/google_16k/textured.obj`` (official archives) or ``models/<id>/textured.obj`` (YCB-Video),
+  metres, the published masses of :mod:`graspexp.datasets.ycb_objects`;
+- ``bop``: any BOP set (:mod:`graspexp.datasets.bop`), millimetres; ``linemod`` is the catalogued instance;
+- ``folder``: your own meshes and URDFs (:mod:`graspexp.datasets.folder`);
+- ``primitives``: procedural shapes (:mod:`graspexp.datasets.primitives`).
 
 Nothing here reads a mesh; :mod:`graspexp.datasets.loader` does that.
 """
@@ -10,71 +18,29 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from graspexp.datasets import bop, folder
 from graspexp.datasets.errors import DatasetError
+from graspexp.datasets.source import MeshPart, ObjectSource
+from graspexp.datasets.ycb_objects import YCB_MASS_KG
 
 DATA_ENV = "GRASPEXP_DATA"
 """Environment variable naming the data root when ``dataset.root`` is not set."""
 DEFAULT_ROOT = "datasets"
 """Data root (relative to the working directory) when neither ``dataset.root`` nor the env var is set."""
 
-# Published YCB masses in kg: Calli et al., "Benchmarking in Manipulation Research: The YCB Object and
-# Model Set and Benchmarking Protocols", IEEE RAM 2015, Table 1 (also the object list on
-# ycbbenchmarks.com). The keys are the catalogue of YCB objects this package knows; it covers the 21
-# YCB-Video objects and both screwdrivers (paper Table 1 uses 043_phillips_screwdriver).
-YCB_MASS_KG: dict[str, float] = {
-    "002_master_chef_can": 0.414,
-    "003_cracker_box": 0.411,
-    "004_sugar_box": 0.514,
-    "005_tomato_soup_can": 0.349,
-    "006_mustard_bottle": 0.603,
-    "007_tuna_fish_can": 0.171,
-    "008_pudding_box": 0.187,
-    "009_gelatin_box": 0.097,
-    "010_potted_meat_can": 0.370,
-    "011_banana": 0.066,
-    "019_pitcher_base": 0.178,
-    "021_bleach_cleanser": 1.131,
-    "024_bowl": 0.147,
-    "025_mug": 0.118,
-    "035_power_drill": 0.895,
-    "036_wood_block": 0.729,
-    "037_scissors": 0.082,
-    "040_large_marker": 0.0158,
-    "043_phillips_screwdriver": 0.097,
-    "044_flat_screwdriver": 0.0984,
-    "051_large_clamp": 0.125,
-    "052_extra_large_clamp": 0.202,
-    "061_foam_brick": 0.028,
-}
-
-# LINEMOD / BOP ``lm`` object ids (Hinterstoisser et al., ACCV 2012; paper Table 2 order).
-LINEMOD_IDS: dict[str, int] = {
-    "ape": 1,
-    "benchvise": 2,
-    "cam": 4,
-    "can": 5,
-    "cat": 6,
-    "driller": 8,
-    "duck": 9,
-    "eggbox": 10,
-    "glue": 11,
-    "holepuncher": 12,
-    "iron": 13,
-    "lamp": 14,
-    "phone": 15,
-}
-
-LINEMOD_MM_TO_M = 1e-3
-"""BOP LINEMOD models are in millimetres."""
+LINEMOD_IDS: dict[str, int] = {name: i for i, name in bop.LM_NAMES.items() if name not in ("bowl", "cup")}
+"""The 13 LINEMOD objects of paper Table 2 (BOP ``lm`` ids; bowl and cup have no pose benchmark)."""
+LINEMOD_MM_TO_M = bop.MM_TO_M
 
 PRIMITIVE_NAMES: tuple[str, ...] = ("can", "box", "bottle", "mug", "banana", "block")
 
 
 @dataclass(frozen=True)
 class DatasetSpec:
-    """Static facts about one dataset (the registry value; the config's ``dataset.name`` is the key)."""
+    """Static facts about one catalogued dataset (the registry value; ``dataset.name`` is the key)."""
 
     name: str
+    layout: str
     catalogue: tuple[str, ...]
     """Every object name the loader accepts."""
     default_objects: tuple[str, ...]
@@ -87,6 +53,7 @@ class DatasetSpec:
 DATASETS: dict[str, DatasetSpec] = {
     "ycb": DatasetSpec(
         name="ycb",
+        layout="ycb",
         catalogue=tuple(YCB_MASS_KG),
         default_objects=(
             "021_bleach_cleanser",
@@ -104,6 +71,7 @@ DATASETS: dict[str, DatasetSpec] = {
     ),
     "linemod": DatasetSpec(
         name="linemod",
+        layout="bop",
         catalogue=tuple(LINEMOD_IDS),
         default_objects=tuple(LINEMOD_IDS),
         subfolder="linemod",
@@ -111,12 +79,14 @@ DATASETS: dict[str, DatasetSpec] = {
     ),
     "primitives": DatasetSpec(
         name="primitives",
+        layout="primitives",
         catalogue=PRIMITIVE_NAMES,
         default_objects=PRIMITIVE_NAMES,
         subfolder=None,
         downloadable=False,
     ),
 }
+"""The catalogued datasets: their object names are known without reading the data root."""
 
 
 def dataset_spec(name: str) -> DatasetSpec:
@@ -125,8 +95,33 @@ def dataset_spec(name: str) -> DatasetSpec:
         return DATASETS[name]
     except KeyError:
         raise DatasetError(
-            f"unknown dataset {name!r} (dataset.name); valid names: {', '.join(sorted(DATASETS))}"
+            f"unknown dataset {name!r} (dataset.name); catalogued: {', '.join(sorted(DATASETS))}; "
+            "for your own objects use dataset=folder or dataset=bop with dataset.root=DIR"
         ) from None
+
+
+def catalogued(cfg: Any) -> DatasetSpec | None:
+    """The registry entry of ``cfg`` if it is a catalogued set read in its own layout, else None. A
+    catalogued name read in another layout is refused (its tables would pass for the paper's)."""
+    spec = DATASETS.get(cfg.name)
+    layout = getattr(cfg, "layout", None)
+    if spec is None or layout in (None, spec.layout):
+        return spec
+    raise DatasetError(
+        f"dataset.name={cfg.name!r} is the catalogued {spec.layout} set; a dataset read with "
+        f"dataset.layout={layout} needs another name (dataset.name=...)"
+    )
+
+
+def layout_of(cfg: Any) -> str:
+    """The layout ``cfg`` is read with (``dataset.layout``, or the catalogued set's)."""
+    spec = catalogued(cfg)
+    if spec is not None:
+        return spec.layout
+    layout = getattr(cfg, "layout", None)
+    if layout is None:
+        dataset_spec(cfg.name)  # raises, naming the catalogued sets and the layouts
+    return str(layout)
 
 
 def download_command(name: str, root: Path | str) -> str:
@@ -141,6 +136,8 @@ def resolve_root(cfg: Any) -> Path:
     """
     root = getattr(cfg, "root", None)
     if root in (None, ""):
+        if getattr(cfg, "layout", None) == "folder":
+            raise DatasetError("dataset=folder needs the folder of your meshes: dataset.root=DIR")
         root = os.environ.get(DATA_ENV) or DEFAULT_ROOT
     return Path(str(root)).expanduser()
 
@@ -148,36 +145,72 @@ def resolve_root(cfg: Any) -> Path:
 def dataset_dir(cfg: Any) -> Path:
     """The dataset folder: ``<root>/<subfolder>`` if that exists, else the root itself.
 
-    So ``dataset.root`` may name either the common data root (holding ``ycb/`` and ``linemod/``) or the
-    dataset's own folder (a folder of ``<id>/google_16k/`` or a BOP folder holding ``models/``).
+    So ``dataset.root`` may name either the common data root (holding ``ycb/``, ``linemod/`` or a BOP set's
+    folder named by ``dataset.bop_set``) or the dataset's own folder.
     """
-    spec = dataset_spec(cfg.name)
     root = resolve_root(cfg)
-    if spec.subfolder is not None and (root / spec.subfolder).is_dir():
-        return root / spec.subfolder
+    spec = catalogued(cfg)
+    sub = spec.subfolder if spec is not None else getattr(cfg, "bop_set", None)
+    if sub and (root / sub).is_dir():
+        return root / sub
     return root
 
 
-def check_object_name(dataset: str, name: str) -> None:
-    """Raise :class:`DatasetError` listing the valid names if ``name`` is not in the catalogue."""
-    spec = dataset_spec(dataset)
-    if name not in spec.catalogue:
+def _bop_models(cfg: Any) -> tuple[Path, dict[str, int]]:
+    """(models folder, name -> model id) of a BOP-layout dataset."""
+    models = bop.models_dir(dataset_dir(cfg))
+    spec = catalogued(cfg)
+    if spec is not None:
+        return models, LINEMOD_IDS
+    if not models.is_dir():
         raise DatasetError(
-            f"unknown object {name!r} in dataset {dataset!r}; valid names: {', '.join(spec.catalogue)}"
+            f"BOP dataset folder {models.resolve()} does not exist (dataset.root / ${DATA_ENV})"
+        )
+    bop_set = getattr(cfg, "bop_set", None) or dataset_dir(cfg).name
+    return models, bop.object_names(bop.model_ids(models), str(bop_set))
+
+
+def catalogue(cfg: Any) -> tuple[str, ...]:
+    """Every object name dataset ``cfg`` accepts (a folder's and a BOP set's are read from disk)."""
+    spec = catalogued(cfg)
+    if spec is not None:
+        return spec.catalogue
+    layout = layout_of(cfg)
+    if layout == "folder":
+        return tuple(folder.scan(dataset_dir(cfg)))
+    return tuple(_bop_models(cfg)[1])
+
+
+def default_objects(cfg: Any) -> tuple[str, ...]:
+    """The objects of a run when ``dataset.objects`` is empty: the paper's list, or every object."""
+    spec = catalogued(cfg)
+    return spec.default_objects if spec is not None else catalogue(cfg)
+
+
+def check_object_name(cfg: Any, name: str) -> None:
+    """Raise :class:`DatasetError` listing the valid names if ``name`` is not in the catalogue."""
+    names = catalogue(cfg)
+    if name not in names:
+        raise DatasetError(
+            f"unknown object {name!r} in dataset {cfg.name!r}; valid names: {', '.join(names)}"
         )
 
 
 def candidate_paths(cfg: Any, name: str) -> list[Path]:
     """The mesh files that may hold object ``name``, in the order they are tried (empty for primitives)."""
-    check_object_name(cfg.name, name)
-    folder = dataset_dir(cfg)
-    if cfg.name == "ycb":
+    check_object_name(cfg, name)
+    layout = layout_of(cfg)
+    if layout == "ycb":
+        base = dataset_dir(cfg)
         return [
-            folder / name / "google_16k" / "textured.obj",  # official google_16k archives
-            folder / "models" / name / "textured.obj",  # YCB-Video layout
+            base / name / "google_16k" / "textured.obj",  # official google_16k archives
+            base / "models" / name / "textured.obj",  # YCB-Video layout
         ]
-    if cfg.name == "linemod":
-        return [folder / "models" / f"obj_{LINEMOD_IDS[name]:06d}.ply"]  # BOP layout, millimetres
+    if layout == "bop":
+        models, ids = _bop_models(cfg)
+        return [bop.model_file(models, ids[name])]
+    if layout == "folder":
+        return [folder.scan(dataset_dir(cfg))[name].file]
     return []
 
 
@@ -188,14 +221,47 @@ def mesh_path(cfg: Any, name: str) -> Path:
         if path.is_file():
             return path
     root = resolve_root(cfg)
-    folder = dataset_dir(cfg)
-    fix = f"download it with: {download_command(cfg.name, root)}"
-    if not folder.is_dir():
+    base = dataset_dir(cfg)
+    fix = f"download it with: {download_command(cfg.name, root)}" if catalogued(cfg) else "put it there"
+    if not base.is_dir():
         raise DatasetError(
-            f"{cfg.name} dataset folder {folder.resolve()} does not exist (dataset.root / ${DATA_ENV}); {fix}"
+            f"{cfg.name} dataset folder {base.resolve()} does not exist (dataset.root / ${DATA_ENV}); {fix}"
         )
     tried = " or ".join(str(p.resolve()) for p in paths)
     raise DatasetError(f"mesh file for {cfg.name} object {name!r} not found: {tried}; {fix}")
+
+
+def object_source(cfg: Any, name: str) -> ObjectSource:
+    """What object ``name`` of dataset ``cfg`` is made of (files, units, published mass and size, sidecar)."""
+    layout = layout_of(cfg)
+    if layout == "primitives":
+        check_object_name(cfg, name)
+        return ObjectSource(name=name, parts=())
+    if layout == "folder":
+        base = dataset_dir(cfg)
+        entries = folder.scan(base)
+        if name not in entries:
+            check_object_name(cfg, name)
+        return folder.object_source(base, entries[name], str(cfg.units))
+    path = mesh_path(cfg, name)
+    if layout == "ycb":
+        return ObjectSource(
+            name=name, parts=(MeshPart(path),), source=str(path.resolve()), mass_kg=YCB_MASS_KG[name]
+        )
+    models, ids = _bop_models(cfg)
+    info = bop.read_models_info(models).get(ids[name]) if (models / bop.INFO_FILE).is_file() else None
+    notes = (
+        "units: mm (BOP)",
+        "mass: volume x dataset.density_kg_m3",
+        info.symmetry_note() if info else f"size not checked: no entry in {models / bop.INFO_FILE}",
+    )
+    return ObjectSource(
+        name=name,
+        parts=(MeshPart(path, scale=bop.MM_TO_M),),
+        source=str(path.resolve()),
+        published_size=info.size_mm if info else None,
+        notes=tuple(n for n in notes if n),
+    )
 
 
 def dataset_objects(cfg: Any) -> list[str]:
@@ -203,15 +269,14 @@ def dataset_objects(cfg: Any) -> list[str]:
 
     Every name is checked against the catalogue (an unknown name lists the valid ones).
     """
-    spec = dataset_spec(cfg.name)
-    names = [str(n) for n in (getattr(cfg, "objects", None) or spec.default_objects)]
+    names = [str(n) for n in (getattr(cfg, "objects", None) or default_objects(cfg))]
     for name in names:
-        check_object_name(cfg.name, name)
+        check_object_name(cfg, name)
     return names
 
 
 def available_objects(cfg: Any) -> list[str]:
     """The names of :func:`dataset_objects` whose mesh files exist under the data root."""
-    if cfg.name == "primitives":
+    if layout_of(cfg) in ("primitives", "folder"):
         return dataset_objects(cfg)
     return [n for n in dataset_objects(cfg) if any(p.is_file() for p in candidate_paths(cfg, n))]

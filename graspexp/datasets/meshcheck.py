@@ -4,24 +4,23 @@
   the Katamari encoder of the YCB google_16k meshes) against the ``v`` and ``f`` lines present.
 - PLY: the header's ``element`` counts against the body (ASCII: one line per element; binary: the bytes
   the fixed-size elements need at least).
-- BOP (LINEMOD): ``models_info.json`` beside the models publishes each model's size; the loaded extents
-  must match it.
+- BOP: ``models_info.json`` beside the models publishes each model's size; the loaded extents must match
+  it (:func:`check_published_size`).
 - Any dataset mesh: a sane size (:data:`MIN_EXTENT_M` ... :data:`MAX_EXTENT_M`). (The loader also
   requires a closed mesh to enclose a positive volume no larger than its convex hull's.) No dataset here
   publishes volumes or watertightness, so those are checked for consistency only.
 
-Every failure is one :class:`DatasetError` naming the file and what is wrong with it.
+Every failure is one :class:`ObjectError` naming the file and what is wrong with it.
 """
 
 from __future__ import annotations
 
-import json
 import re
 from pathlib import Path
 
 import numpy as np
 
-from graspexp.datasets.errors import DatasetError
+from graspexp.datasets.errors import DatasetError, ObjectError
 
 MIN_EXTENT_M, MAX_EXTENT_M = 0.005, 1.0
 """A graspable object's largest extent lies in this range, m (outside: wrong units or a broken file)."""
@@ -32,8 +31,8 @@ _PLY_SIZES = {"char": 1, "uchar": 1, "int8": 1, "uint8": 1, "short": 2, "ushort"
               "int": 4, "uint": 4, "int32": 4, "uint32": 4, "float": 4, "float32": 4, "double": 8, "float64": 8}  # fmt: skip
 
 
-def _damaged(path: Path, what: str) -> DatasetError:
-    return DatasetError(f"broken mesh {path}: {what} (a cut or damaged file?); download it again")
+def _damaged(path: Path, what: str) -> ObjectError:
+    return ObjectError(f"broken mesh {path}: {what} (a cut or damaged file?); download it again")
 
 
 def obj_counts(data: bytes) -> tuple[int, int]:
@@ -102,31 +101,34 @@ def check_file(path: Path) -> None:
         check_ply(path, data)
 
 
-def check_geometry(what: str, extents_m: np.ndarray) -> None:
-    """Raise DatasetError unless the largest extent is a graspable object's size."""
+def check_geometry(what: str, extents_m: np.ndarray, units_hint: str = "") -> None:
+    """Raise ObjectError unless the largest extent is a graspable object's size; ``units_hint`` says where
+    the user sets the file's units (then the message also proposes the units that would fit)."""
     size = float(np.max(extents_m))
-    if not MIN_EXTENT_M <= size <= MAX_EXTENT_M:
-        raise DatasetError(
-            f"broken mesh {what}: largest extent {size:.4g} m is outside [{MIN_EXTENT_M}, {MAX_EXTENT_M}] m "
-            "(wrong units, e.g. millimetres read as metres, or a broken file)"
+    if MIN_EXTENT_M <= size <= MAX_EXTENT_M:
+        return
+    if units_hint:
+        fits = [
+            f"{name} ({size * factor:.3g} m)"
+            for name, factor in (("mm", 1e-3), ("cm", 1e-2), ("m", 1.0), ("inches", 0.0254))
+            if MIN_EXTENT_M <= size * factor <= MAX_EXTENT_M
+        ]
+        guess = f"; in {' or '.join(fits)} it would be" if fits else ""
+        raise ObjectError(
+            f"mesh {what}: its largest extent reads as {size:.4g} m (extents {np.round(extents_m, 4).tolist()} m), "
+            f"outside a graspable object's [{MIN_EXTENT_M}, {MAX_EXTENT_M}] m{guess}: set its units with {units_hint}"
         )
+    raise ObjectError(
+        f"broken mesh {what}: largest extent {size:.4g} m is outside [{MIN_EXTENT_M}, {MAX_EXTENT_M}] m "
+        "(wrong units, e.g. millimetres read as metres, or a broken file)"
+    )
 
 
-def check_bop_info(path: Path, model_id: int, extents_file_units: np.ndarray) -> None:
-    """Compare a BOP model's extents (file units, mm) with ``models_info.json`` beside it, when it lists the id."""
-    info_path = path.parent / "models_info.json"
-    if not info_path.is_file():
-        return
-    try:
-        info = json.loads(info_path.read_text()).get(str(model_id))
-    except (OSError, json.JSONDecodeError, AttributeError) as err:
-        raise DatasetError(f"cannot read {info_path}: {err}") from None
-    if not info or not all(k in info for k in ("size_x", "size_y", "size_z")):
-        return
-    published = np.array([info["size_x"], info["size_y"], info["size_z"]], dtype=float)
+def check_published_size(path: Path, extents_file_units: np.ndarray, published: np.ndarray) -> None:
+    """Compare a model's extents (file units) with the size its dataset publishes (BOP ``models_info.json``)."""
     if np.any(np.abs(extents_file_units - published) > 0.5 + BOP_SIZE_TOLERANCE * published):
         raise _damaged(
             path,
             f"its extents {np.round(extents_file_units, 2).tolist()} differ from the published size "
-            f"{published.round(2).tolist()} in {info_path.name}",
+            f"{np.round(published, 2).tolist()} in models_info.json",
         )

@@ -18,7 +18,7 @@ class ObjectModel:
     area_mask : (N,) bool, True where the point lies in the grasping area.
     mass_kg : mass, kg.
     name : catalogue name, e.g. ``025_mug`` or ``ape``.
-    dataset : ``ycb``, ``linemod`` or ``primitives``.
+    dataset : the dataset's name (``dataset.name``).
     source : file the mesh came from ("" for procedural meshes).
     """
 
@@ -30,6 +30,8 @@ class ObjectModel:
     area_mask: np.ndarray
     mass_kg: float
     source: str = ""
+    friction: float | None = None
+    notes: tuple[str, ...] = ()
 
     @cached_property
     def mesh_sha256(self) -> str:

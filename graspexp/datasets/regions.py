@@ -48,7 +48,7 @@ import trimesh
 import yaml
 from sklearn.neighbors import KDTree
 
-from graspexp.datasets.errors import DatasetError
+from graspexp.datasets.errors import DatasetError, ObjectError
 
 REGIONS_DIR = Path(__file__).parent / "regions"
 """Folder of the version-controlled region spec files."""
@@ -110,6 +110,16 @@ class RegionSpec:
     note: str = ""
 
 
+def whole_surface(name: str) -> RegionSpec:
+    """The area of an object that has no spec: its whole surface."""
+    return RegionSpec(
+        name=name,
+        spec_file=Path("<no area spec>"),
+        ops=(RegionOp(keep=True, shape="all", params={}, relative=False),),
+        note="whole surface (no area given)",
+    )
+
+
 def regions_path(regions: str) -> Path:
     """The spec file named by ``dataset.regions``: an existing path as given, else under ``REGIONS_DIR``."""
     given = Path(regions).expanduser()
@@ -139,10 +149,12 @@ def _load_specs_cached(path: Path, _mtime_ns: int) -> dict[str, RegionSpec]:
         raise DatasetError(f"grasping-area spec file {path} is not valid YAML: {err}") from None
     if not isinstance(data, dict):
         raise DatasetError(f"grasping-area spec file {path} must map object names to region specs")
-    return {str(name): _parse_entry(str(name), entry, path) for name, entry in data.items()}
+    return {str(name): parse_entry(str(name), entry, path) for name, entry in data.items()}
 
 
-def _parse_entry(name: str, entry: Any, path: Path) -> RegionSpec:
+def parse_entry(name: str, entry: Any, path: Path) -> RegionSpec:
+    """Object ``name``'s entry (a mapping or a list of operations) of spec file or sidecar ``path``, validated
+    as strictly as a config (known keys, booleans, numbers); raises DatasetError naming the file and key."""
     where = f"{path}: object {name!r}"
     if isinstance(entry, list):
         entry = {"ops": entry}
@@ -151,7 +163,7 @@ def _parse_entry(name: str, entry: Any, path: Path) -> RegionSpec:
     unknown = set(entry) - _ENTRY_KEYS
     if unknown:
         raise DatasetError(f"{where}: unknown keys {sorted(unknown)}; valid keys: {sorted(_ENTRY_KEYS)}")
-    relative = bool(entry.get("relative", False))
+    relative = _flag(entry.get("relative", False), f"{where}: relative")
     raw_ops = entry.get("ops") or []
     if not isinstance(raw_ops, list):
         raise DatasetError(f"{where}: 'ops' must be a list of operations")
@@ -163,8 +175,10 @@ def _parse_entry(name: str, entry: Any, path: Path) -> RegionSpec:
         spec_file=path,
         ops=ops,
         meshlab_ply=entry.get("meshlab_ply"),
-        scale=float(entry.get("scale", 1.0)),
-        tolerance_m=None if entry.get("tolerance_m") is None else float(entry["tolerance_m"]),
+        scale=_positive(entry.get("scale", 1.0), f"{where}: scale"),
+        tolerance_m=None
+        if entry.get("tolerance_m") is None
+        else _positive(entry["tolerance_m"], f"{where}: tolerance_m"),
         note=str(entry.get("note", "")),
     )
 
@@ -183,7 +197,7 @@ def _parse_op(op: Any, relative: bool, where: str) -> RegionOp:
     if not isinstance(params, dict):
         raise DatasetError(f"{where}: parameters of {kind} must be a mapping, got {params!r}")
     params = dict(params)
-    op_relative = bool(params.pop("relative", relative))
+    op_relative = _flag(params.pop("relative", relative), f"{where}: {kind}.relative")
     expected = _SHAPE_PARAMS.get(shape, ())
     if set(params) != set(expected):
         raise DatasetError(f"{where}: {kind} takes exactly {list(expected)}, got {sorted(params)}")
@@ -199,6 +213,20 @@ def _parse_op(op: Any, relative: bool, where: str) -> RegionOp:
     if "radius" in params and not float(params["radius"]) > 0:
         raise DatasetError(f"{where}: {kind}.radius must be > 0, got {params['radius']}")
     return RegionOp(keep=mode == "keep", shape=shape, params=params, relative=op_relative)
+
+
+def _flag(value: Any, what: str) -> bool:
+    """``value`` if it is a YAML boolean (``true``/``false``), else a DatasetError: ``"false"`` is not false."""
+    if not isinstance(value, bool):
+        raise DatasetError(f"{what} must be true or false (unquoted), got {value!r}")
+    return value
+
+
+def _positive(value: Any, what: str) -> float:
+    """``value`` as a float if it is a finite positive number, else a DatasetError naming ``what``."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not (0 < value < float("inf")):
+        raise DatasetError(f"{what} must be a positive number, got {value!r}")
+    return float(value)
 
 
 def _is_numeric(value: Any) -> bool:
@@ -269,7 +297,7 @@ def area_mask(
         start = import_meshlab_area(ply, points, scale=spec.scale, tolerance_m=spec.tolerance_m)
     mask = apply_ops(spec.ops, points, bounds, start)
     if not mask.any():
-        raise DatasetError(
+        raise ObjectError(
             f"empty grasping area for object {spec.name!r}: no point of its cloud passes the region spec "
             f"in {spec.spec_file}; fix the boxes/half-spaces there"
         )

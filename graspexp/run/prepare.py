@@ -13,10 +13,9 @@ from omegaconf import DictConfig, OmegaConf
 from tqdm import tqdm
 
 from graspexp.config import SimConfig
-from graspexp.datasets import DatasetError, available_objects
-from graspexp.datasets.catalog import dataset_spec
+from graspexp.datasets import DatasetError, available_objects, catalogue
 from graspexp.datasets.loader import object_mesh
-from graspexp.sim.collision_shapes import collision_shape, is_cached
+from graspexp.sim.collision_shapes import is_cached, shape_with_fallback
 
 log = logging.getLogger(__name__)
 REFRESH_S = 5.0
@@ -26,7 +25,7 @@ REFRESH_S = 5.0
 def _build_one(dataset: dict, sim: SimConfig | DictConfig, name: str) -> tuple[str, float, float, int]:
     """Build (and cache) one object's shape; (name, wall s, CPU s, parts)."""
     t0, c0 = time.perf_counter(), time.process_time()
-    shape = collision_shape(object_mesh(OmegaConf.create(dataset), name)[0].mesh, sim)
+    shape, _ = shape_with_fallback(object_mesh(OmegaConf.create(dataset), name)[0].mesh, sim)
     return name, time.perf_counter() - t0, time.process_time() - c0, len(shape.parts)
 
 
@@ -91,5 +90,5 @@ def _report(bar: tqdm, result: tuple[str, float, float, int]) -> None:
 
 def staged_objects(dataset_cfg: DictConfig) -> list[str]:
     """Every catalogue object of the dataset whose mesh file exists under the data root."""
-    every = OmegaConf.merge(dataset_cfg, {"objects": list(dataset_spec(dataset_cfg.name).catalogue)})
+    every = OmegaConf.merge(dataset_cfg, {"objects": list(catalogue(dataset_cfg))})
     return available_objects(every)

@@ -37,7 +37,7 @@ from tqdm import tqdm
 from graspexp.config import BEFORE, validate
 from graspexp.core.outcome import FailureReason, TrialResult
 from graspexp.core.seeding import trial_seed
-from graspexp.datasets import job_object, select_objects
+from graspexp.datasets import ObjectError, job_object, select_objects
 from graspexp.datasets.model import ObjectModel
 from graspexp.planning import plan
 from graspexp.quality import fc_min_mu
@@ -53,7 +53,8 @@ from graspexp.record.reader import read_metadata
 from graspexp.record.scene import ObjectScene, object_scene
 from graspexp.record.writer import is_write_error
 from graspexp.run.prepare import prepare_shapes
-from graspexp.sim.collision_shapes import collision_shape
+from graspexp.sim.collision_shapes import ShapeError, shape_with_fallback
+from graspexp.sim.shape import CollisionShape
 from graspexp.sim.trial import TrialContext, plain_config, run_trial
 
 log = logging.getLogger(__name__)
@@ -98,6 +99,17 @@ class RunError(RuntimeError):
     directory held by another run or holding logs of another config. The message is one line."""
 
 
+@dataclasses.dataclass(frozen=True)
+class LoadedObject:
+    """An object ready for its trials: model, collision shape, Foxglove scene, and what was assumed."""
+
+    model: ObjectModel
+    hulls: CollisionShape
+    scene: ObjectScene
+    notes: tuple[str, ...]
+    """The model's notes (units, mass, area) and the collision shape's (a fallback method)."""
+
+
 def job_metadata(cfg: DictConfig) -> dict[str, str]:
     """The part of every trial's MCAP metadata that is the same for the whole job."""
     meta = {"config_yaml": OmegaConf.to_yaml(cfg, resolve=True), "global_seed": str(cfg.seed)}
@@ -105,17 +117,41 @@ def job_metadata(cfg: DictConfig) -> dict[str, str]:
     return meta
 
 
-def _metadata(job_meta: dict[str, str], model: ObjectModel, trial: int, seed: int) -> dict[str, str]:
+def _metadata(job_meta: dict[str, str], loaded: LoadedObject, trial: int, seed: int) -> dict[str, str]:
     """One trial's log metadata: the job's, the trial's seeds and what its object was made of (the mesh
-    file, "" for a procedural one, and the SHA-256 of the geometry used)."""
+    file, "" for a procedural one, the SHA-256 of the geometry used, the collision method it got, and what
+    was assumed for it: units, mass, area)."""
     return {
         **job_meta,
-        "object": model.name,
+        "object": loaded.model.name,
         "trial": str(trial),
         "trial_seed": str(seed),
-        "mesh_source": model.source,
-        "mesh_sha256": model.mesh_sha256,
+        "mesh_source": loaded.model.source,
+        "mesh_sha256": loaded.model.mesh_sha256,
+        "collision_method": loaded.hulls.method,
+        "object_notes": "\n".join(loaded.notes),
     }
+
+
+def _unusable_object_trials(
+    cfg: DictConfig, object_name: str, run_dir: Path, reason: str, bar: tqdm | None
+) -> list[TrialResult]:
+    """Every trial of an object that cannot be used: an ``error`` result with ``reason``, logged (when
+    ``record``) so that the report counts it; resume tries the object again."""
+    plain = plain_config(cfg)
+    results = []
+    for i in range(cfg.trials):
+        seed = trial_seed(plain, object_name, i)
+        result = _error_result(cfg, object_name, i, seed, ObjectError(reason))
+        path = trial_log_path(run_dir, object_name, i)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        meta = {**job_metadata(cfg), "object": object_name, "trial": str(i), "trial_seed": str(seed)}
+        with trial_recorder(path if cfg.record else None, meta, plain) as rec:
+            rec.result(0.0, result.to_dict())
+        results.append(result)
+        if bar is not None:
+            bar.update()
+    return results
 
 
 def check_same_meshes(run_dir: Path, models: dict[str, ObjectModel]) -> None:
@@ -156,16 +192,24 @@ def _error_result(
     )
 
 
-def load_models(cfg: DictConfig, objects: list[str]) -> dict[str, tuple[ObjectModel, list, ObjectScene]]:
-    """(model, convex hulls, Foxglove scene) of every object, before any trial runs: a missing or broken
-    mesh, region spec or data folder stops the job here (DatasetError) instead of filling a table."""
+def load_models(cfg: DictConfig, objects: list[str]) -> tuple[dict[str, LoadedObject], dict[str, str]]:
+    """({name: loaded object}, {name: why it cannot be used}), before any trial runs. An object whose mesh,
+    sidecar or area is unusable (:class:`ObjectError`) or for which no collision shape can be built
+    (:class:`ShapeError`) fails alone; a missing data folder or file, or a broken region spec file, stops
+    the job here (DatasetError) instead of filling a table."""
     plain = plain_config(cfg)
-    out = {}
+    out, failed = {}, {}
     for name in objects:
-        model = job_object(cfg, name)
-        hulls = collision_shape(model.mesh, plain.sim)
-        out[name] = (model, hulls, object_scene(plain, hulls))
-    return out
+        try:
+            model = job_object(cfg, name)
+            hulls, shape_note = shape_with_fallback(model.mesh, plain.sim)
+        except (ObjectError, ShapeError) as exc:
+            log.error("object %s cannot be used: %s", name, exc)
+            failed[name] = str(exc)
+            continue
+        notes = (*model.notes, shape_note) if shape_note else model.notes
+        out[name] = LoadedObject(model, hulls, object_scene(plain, hulls), notes)
+    return out, failed
 
 
 def run_object_trials(
@@ -173,16 +217,22 @@ def run_object_trials(
     object_name: str,
     run_dir: Path,
     bar: tqdm | None = None,
-    loaded: tuple[ObjectModel, list, ObjectScene] | None = None,
+    loaded: LoadedObject | str | None = None,
 ) -> list[TrialResult]:
     """Every trial of one object; finished trials found in ``run_dir`` are read back instead of re-run.
 
-    ``loaded``: the object's (model, hulls, scene) from :func:`load_models` (loaded here if None). An
-    exception inside a trial is that trial's ``error`` result; an unwritable log stops the job (RunError).
+    ``loaded``: the object from :func:`load_models`, or the reason it cannot be used (then every trial is
+    an ``error`` result with that reason); loaded here if None. An exception inside a trial is that trial's
+    ``error`` result; an unwritable log stops the job (RunError).
     """
     plain = plain_config(cfg)
     job_meta = job_metadata(cfg)
-    model, hulls, scene = loaded or load_models(cfg, [object_name])[object_name]
+    if loaded is None:
+        ready, failed = load_models(cfg, [object_name])
+        loaded = ready.get(object_name) or failed[object_name]
+    if isinstance(loaded, str):
+        return _unusable_object_trials(cfg, object_name, run_dir, loaded, bar)
+    model, hulls, scene = loaded.model, loaded.hulls, loaded.scene
     results = []
     for i in range(cfg.trials):
         path = trial_log_path(run_dir, object_name, i)
@@ -191,7 +241,7 @@ def run_object_trials(
         if result is None:
             try:
                 path.parent.mkdir(parents=True, exist_ok=True)
-                meta = _metadata(job_meta, model, i, seed)
+                meta = _metadata(job_meta, loaded, i, seed)
                 recorder = trial_recorder(path if cfg.record else None, meta, plain)
                 with recorder as rec:
                     try:
@@ -355,6 +405,14 @@ def summarize(df: pd.DataFrame) -> pd.DataFrame:
     return table
 
 
+def object_notes(models: dict[str, LoadedObject], unusable: dict[str, str]) -> str:
+    """The summary's lines on what was assumed for each object and why an object could not be used
+    ("" when there is nothing to say)."""
+    lines = [f"- {name}: {'; '.join(o.notes)}" for name, o in models.items() if o.notes]
+    lines += [f"- {name}: NOT RUN, {why}" for name, why in unusable.items()]
+    return "\n\nObjects:\n" + "\n".join(lines) if lines else ""
+
+
 def run_job(cfg: DictConfig) -> float:
     """Run every trial for every selected object; returns the overall success rate in [0, 1]."""
     from hydra.core.hydra_config import HydraConfig
@@ -376,8 +434,8 @@ def _run(cfg: DictConfig, run_dir: Path) -> float:
     objects = select_objects(cfg.dataset, cfg.objects)
     check_resumable(cfg, run_dir)
     prepare_shapes(cfg.dataset, cfg.sim, objects, cfg.progress)
-    models = load_models(cfg, objects)
-    check_same_meshes(run_dir, {name: loaded[0] for name, loaded in models.items()})
+    models, unusable = load_models(cfg, objects)
+    check_same_meshes(run_dir, {name: loaded.model for name, loaded in models.items()})
     results: list[TrialResult] = []
     with tqdm(
         total=len(objects) * cfg.trials,
@@ -385,11 +443,11 @@ def _run(cfg: DictConfig, run_dir: Path) -> float:
         disable=not cfg.progress,
     ) as bar:
         for name in objects:
-            results.extend(run_object_trials(cfg, name, run_dir, bar, models[name]))
+            results.extend(run_object_trials(cfg, name, run_dir, bar, models.get(name) or unusable[name]))
     df = pd.DataFrame([r.to_dict() for r in results])
     df.to_csv(run_dir / "results.csv", index=False)
     table = summarize(df)
-    text = table.to_markdown(floatfmt=".3g")
+    text = table.to_markdown(floatfmt=".3g") + object_notes(models, unusable)
     (run_dir / "summary.md").write_text(text + "\n")
     print(
         f"\n{cfg.mode.name} / rot {cfg.rot.name} / {cfg.dataset.name} / planner {cfg.planner.name}: {run_dir}"

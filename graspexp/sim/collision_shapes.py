@@ -14,6 +14,7 @@ parameters, so a changed mesh or parameter never reuses a stale shape. ``mesh`` 
 an OBJ file beside the cache entry: SAPIEN cooks a mesh file once per process and reuses it.
 """
 
+import dataclasses
 import hashlib
 import json
 import os
@@ -24,11 +25,24 @@ from pathlib import Path
 
 import numpy as np
 import trimesh
+from omegaconf import OmegaConf
 
 from graspexp.config import SimConfig
+from graspexp.sim.collision_accuracy import shape_accuracy, surface_points
 from graspexp.sim.shape import CollisionShape
 
 METHODS = ("mesh", "coacd", "vhacd")
+FALLBACK_METHOD = "coacd"
+"""The method an object falls back to when ``mesh`` cannot repair it (a convex decomposition needs no
+closed surface)."""
+
+
+class ShapeError(ValueError):
+    """No collision shape can be built for a mesh (the message names why and what to try)."""
+
+
+class RepairError(ShapeError):
+    """``sim.collision_method=mesh`` cannot repair a part of the mesh into a closed surface."""
 
 
 def cache_dir(cfg: SimConfig) -> Path:
@@ -106,6 +120,30 @@ def collision_shape(mesh: trimesh.Trimesh, cfg: SimConfig) -> CollisionShape:
     return CollisionShape(params["method"], parts, False, obj)
 
 
+def shape_with_fallback(mesh: trimesh.Trimesh, cfg: SimConfig) -> tuple[CollisionShape, str]:
+    """(shape, note): :func:`collision_shape` under ``cfg``; a mesh that ``mesh`` cannot repair (an open
+    low-poly CAD export, say) gets :data:`FALLBACK_METHOD` instead, and the note says so with the measured
+    accuracy of the shape it got ("" when the configured method worked)."""
+    try:
+        return collision_shape(mesh, cfg), ""
+    except RepairError as err:
+        why = str(err).split(";")[0]
+    shape = collision_shape(mesh, _with_method(cfg, FALLBACK_METHOD))
+    acc = shape_accuracy(surface_points(shape, 2000, rng=np.random.default_rng(0)), mesh)
+    return shape, (
+        f"collision: {FALLBACK_METHOD} (fallback: sim.collision_method={cfg.collision_method} failed: "
+        f"{why}); its surface lies outside the mesh by {acc.outside_p50_mm:.2f} mm median, "
+        f"{acc.outside_p90_mm:.2f} mm p90, {acc.outside_max_mm:.2f} mm max"
+    )
+
+
+def _with_method(cfg: SimConfig, method: str) -> SimConfig:
+    """``cfg`` with ``collision_method`` replaced (a SimConfig dataclass or its DictConfig)."""
+    if dataclasses.is_dataclass(cfg):
+        return dataclasses.replace(cfg, collision_method=method)
+    return OmegaConf.merge(cfg, {"collision_method": method})
+
+
 def _build(mesh: trimesh.Trimesh, params: dict) -> tuple[bool, list[tuple[np.ndarray, np.ndarray]]]:
     """(convex, parts) for ``mesh`` under ``params`` (see :func:`collision_shape`)."""
     hull = mesh.convex_hull
@@ -127,7 +165,7 @@ def _build(mesh: trimesh.Trimesh, params: dict) -> tuple[bool, list[tuple[np.nda
         raw = vhacdx.compute_vhacd(np.asarray(mesh.vertices), np.asarray(mesh.faces, dtype=np.uint32), **kw)
     parts = [_part(v, f) for v, f in raw]
     if not parts:
-        raise ValueError(f"convex decomposition of the mesh returned no hull (params {params})")
+        raise ShapeError(f"convex decomposition of the mesh returned no hull (params {params})")
     return True, parts
 
 
@@ -178,7 +216,7 @@ def _closed_shell(component: trimesh.Trimesh, budget: int) -> trimesh.Trimesh:
             )
     shell = trimesh.Trimesh(v, f, process=False)
     if not shell.is_watertight or shell.volume <= 0:
-        raise ValueError(
+        raise RepairError(
             "a part of the mesh could not be repaired into a closed surface for sim.collision_method=mesh "
             f"(after MeshFix: {len(f)} faces, watertight={shell.is_watertight}); "
             "use sim.collision_method=coacd for this object"

@@ -78,11 +78,13 @@ def build_scene(
     drop_pose: np.ndarray,
     mode: ModeConfig,
     sim: SimConfig,
+    friction: float | None = None,
 ) -> TrialScene:
     """Create the scene with the support and the object at ``drop_pose`` ((4,4), world, m).
 
     The object is one dynamic body with ``shape``'s collision parts (convex hulls, or one SDF triangle
-    mesh); its total mass is ``mass_kg``.
+    mesh); its total mass is ``mass_kg``; its surface's Coulomb friction is ``friction`` (static and dynamic)
+    if given (an object's sidecar), else ``sim.object_static_friction`` / ``sim.object_dynamic_friction``.
     In collab mode the support collides with the object only (paper IV-A); in bin mode also with the gripper.
     """
     configure_physx(sim)
@@ -107,7 +109,12 @@ def build_scene(
         support.find_component_by_type(sapien.physx.PhysxRigidStaticComponent), SUPPORT_BIT, support_mask
     )
 
-    obj_mat = sapien.physx.PhysxMaterial(sim.object_static_friction, sim.object_dynamic_friction, 0.0)
+    static, dynamic = (
+        (sim.object_static_friction, sim.object_dynamic_friction)
+        if friction is None
+        else (friction, friction)
+    )
+    obj_mat = sapien.physx.PhysxMaterial(static, dynamic, 0.0)
     body = sapien.physx.PhysxRigidDynamicComponent()
     for part in _object_shapes(shape, obj_mat):
         part.set_density(1000.0)

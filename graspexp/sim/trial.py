@@ -341,7 +341,7 @@ def _drop_until_on_support(ctx: TrialContext, res: TrialResult, timings: dict) -
         rng = rng_for(ctx.trial_seed, "drop", attempt)
         t0 = time.perf_counter()
         pose = drop_pose(ctx.model, cfg.rot.name, cfg.mode.support_height_m, cfg.rot.drop_height_m, rng)
-        ts = build_scene(ctx.hulls, ctx.model.mass_kg, pose, cfg.mode, cfg.sim)
+        ts = build_scene(ctx.hulls, ctx.model.mass_kg, pose, cfg.mode, cfg.sim, ctx.model.friction)
         timings["build"] += time.perf_counter() - t0
         sim = _Sim(ts, cfg, ctx.recorder, timings, log_offset_s)
         if attempt == 0 and ctx.scene is not None:

@@ -11,6 +11,7 @@ TOOLS: tuple[str, ...] = (
     "benchmark",
     "download",
     "prepare",
+    "area",
     "bench.trials",
     "bench.plan_latency",
     "bench.collision_shapes",

@@ -297,9 +297,12 @@ def parse_args(argv: Sequence[str] | None = None) -> argparse.Namespace:
     args = parser.parse_intermixed_args(argv)
     cfg = compose_checked(args.overrides, PROG)
     args.dataset = str(cfg.dataset.name)
-    if not DATASETS[args.dataset].downloadable:
+    if args.dataset not in DATASETS or not DATASETS[args.dataset].downloadable:
         valid = [n for n, spec in DATASETS.items() if spec.downloadable]
-        parser.error(f"dataset={args.dataset} cannot be downloaded; give dataset= one of {', '.join(valid)}")
+        parser.error(
+            f"dataset={args.dataset} cannot be downloaded; give dataset= one of {', '.join(valid)} "
+            "(a folder or BOP set of your own is read where it lies: dataset.root=DIR)"
+        )
     args.root = resolve_root(cfg.dataset)
     args.progress = bool(cfg.progress)
     catalogue = dataset_spec(args.dataset).catalogue

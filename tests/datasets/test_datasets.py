@@ -150,10 +150,12 @@ def test_conf_options_take_the_object_list_from_the_catalogue(name):
     assert set(DATASETS[name].default_objects) <= set(DATASETS[name].catalogue)
 
 
-def test_ycb_catalogue_has_published_masses():
-    assert len(YCB_MASS_KG) == 23
+def test_ycb_catalogue_is_the_whole_object_set_with_published_masses():
+    assert len(YCB_MASS_KG) == 78  # every YCB object that ships a google_16k model
     assert YCB_MASS_KG["010_potted_meat_can"] == 0.370 and YCB_MASS_KG["036_wood_block"] == 0.729
-    assert all(0.01 < m < 1.2 for m in YCB_MASS_KG.values())
+    assert YCB_MASS_KG["014_lemon"] == 0.029 and YCB_MASS_KG["077_rubiks_cube"] == 0.094
+    assert all(0.0009 < m < 1.5 for m in YCB_MASS_KG.values())
+    assert set(DATASETS["ycb"].default_objects) < set(YCB_MASS_KG)
 
 
 def test_resolve_root_precedence(tmp_path, monkeypatch):

@@ -98,7 +98,9 @@ def linemod_archive(folder: Path) -> Path:
         path,
         {
             "models/obj_000001.ply": ply_mm,
-            "models/models_info.json": json.dumps({"1": {"diameter": 69.3}}).encode(),
+            "models/models_info.json": json.dumps(
+                {"1": {"diameter": 69.3, "size_x": 40.0, "size_y": 40.0, "size_z": 40.0}}
+            ).encode(),
             "models_eval/obj_000001.ply": ply_mm,
         },
     )
@@ -206,7 +208,7 @@ def test_cli_arguments(monkeypatch, tmp_path):
     monkeypatch.setenv("GRASPEXP_DATA", str(tmp_path))
     args = download.parse_args(["dataset=ycb", "objects=[025_mug, 011_banana]"])
     assert args.root == tmp_path and args.objects == ["025_mug", "011_banana"]
-    assert len(download.parse_args(["dataset=ycb", "--all"]).objects) == 23
+    assert len(download.parse_args(["dataset=ycb", "--all"]).objects) == 78
     assert download.parse_args(["dataset=linemod", "dataset.root=/x"]).root == Path("/x")
     bad_args = (
         ["dataset.root=/x"],
