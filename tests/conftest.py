@@ -130,3 +130,19 @@ def make_object_folder(folder: Path) -> Path:
         "</link></robot>\n"
     )
     return folder
+
+
+def foreign_log(path: Path, result: dict) -> None:
+    """Write an MCAP file holding only a /result message (no graspexp metadata): not a graspexp trial log."""
+    import json
+
+    from mcap.writer import Writer
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "wb") as f:
+        w = Writer(f)
+        w.start()
+        schema = w.register_schema("graspexp.TrialResult@2", "jsonschema", b"{}")
+        channel = w.register_channel("/result", "json", schema)
+        w.add_message(channel, 0, json.dumps(result).encode(), 0)
+        w.finish()

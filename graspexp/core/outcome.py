@@ -1,6 +1,9 @@
 """A trial's outcome: a closed set of failure reasons and the result record written per trial."""
 
+import dataclasses
 import enum
+import math
+import typing
 from dataclasses import asdict, dataclass, field
 
 
@@ -64,3 +67,57 @@ class TrialResult:
     @classmethod
     def from_dict(cls, d: dict) -> "TrialResult":
         return cls(**{k: d[k] for k in cls.__dataclass_fields__ if k in d})
+
+
+REQUIRED_RESULT_FIELDS = ("dataset", "object", "mode", "rot", "planner", "trial", "seed", "success", "reason")
+"""Fields every /result message has had since the first log format; the others default when absent."""
+
+
+def result_from_dict(d: object) -> TrialResult:
+    """A :class:`TrialResult` from a /result message, checked field by field: the required fields present,
+    each value of its annotated type (``success: "false"`` is not a boolean, ``trial: "abc"`` not an
+    integer), ``reason`` a :class:`FailureReason` value or None, and None exactly when ``success``.
+    Raises ValueError naming the field."""
+    if not isinstance(d, dict):
+        raise ValueError(f"a result is a mapping, got {type(d).__name__}")
+    missing = [k for k in REQUIRED_RESULT_FIELDS if k not in d]
+    if missing:
+        raise ValueError(f"result lacks {missing}")
+    hints = typing.get_type_hints(TrialResult)
+    for f in dataclasses.fields(TrialResult):
+        if f.name in d and not _is_instance(d[f.name], hints[f.name]):
+            raise ValueError(f"result field {f.name}={d[f.name]!r} is not {hints[f.name]}")
+    reasons = {r.value for r in FailureReason}
+    if d["reason"] is not None and d["reason"] not in reasons:
+        raise ValueError(
+            f"result field reason={d['reason']!r} is not a failure reason ({', '.join(sorted(reasons))})"
+        )
+    if d["success"] != (d["reason"] is None):
+        raise ValueError(f"result says success={d['success']} with reason={d['reason']!r}")
+    if d["trial"] < 0:
+        raise ValueError(f"result field trial={d['trial']} is negative")
+    return TrialResult.from_dict(d)
+
+
+def _is_instance(value: object, tp: object) -> bool:
+    """Whether a decoded JSON value fits annotation ``tp`` (bool is not an int; an int is a float)."""
+    origin, args = typing.get_origin(tp), typing.get_args(tp)
+    if origin is typing.Union or type(tp).__name__ == "UnionType":
+        return any(_is_instance(value, a) for a in args)
+    if tp is type(None):
+        return value is None
+    if tp is bool:
+        return isinstance(value, bool)
+    if tp is int:
+        return isinstance(value, int) and not isinstance(value, bool)
+    if tp is float:
+        return isinstance(value, int | float) and not isinstance(value, bool) and not math.isinf(value)
+    if tp is str:
+        return isinstance(value, str)
+    if origin is list:
+        return isinstance(value, list) and all(_is_instance(v, args[0]) for v in value)
+    if origin is dict:
+        return isinstance(value, dict) and all(
+            isinstance(k, str) and _is_instance(v, args[1]) for k, v in value.items()
+        )
+    return True

@@ -401,15 +401,13 @@ def read_metadata(path: Path | str) -> dict[str, str] | None:
     :class:`CorruptLogError` when the file's metadata cannot be read. Reads the summary's metadata index
     only: the fast path beside :func:`read_result`."""
     name = str(path)
-    try:
-        with open(path, "rb") as f:
+    with open(path, "rb") as f:  # an unreadable file is an OSError
+        try:
             for record in SeekingReader(f).iter_metadata():
                 if record.name == S.METADATA_NAME:
                     return dict(record.metadata)
-    except OSError:
-        raise
-    except Exception as exc:  # any parse failure of the file
-        raise CorruptLogError(f"{name}: unreadable metadata ({type(exc).__name__}: {exc})") from exc
+        except Exception as exc:  # any parse failure of the file (a seek before its start included)
+            raise CorruptLogError(f"{name}: unreadable metadata ({type(exc).__name__}: {exc})") from exc
     return None
 
 

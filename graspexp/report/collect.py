@@ -16,6 +16,8 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
+from graspexp.config.differences import result_config
+from graspexp.core.outcome import result_from_dict
 from graspexp.record import TRIALS_DIR, CorruptLogError, read_result
 from graspexp.record.reader import read_config_yaml
 from graspexp.record.writer import PARTIAL_SUFFIX
@@ -27,6 +29,8 @@ NOISE_KEYS: tuple[str, ...] = ("trans_mm", "rot_deg")
 TRIAL_KEYS: tuple[str, ...] = (*SETTING_KEYS, *NOISE_KEYS, "object", "trial")
 """One trial is identified by these fields."""
 RESULTS_CSV = "results.csv"
+CONFIG_COLUMN = "_config"
+"""Working column of :func:`collect`: each log's result-affecting config, flattened (dropped before return)."""
 """The runner's per-run cache of its trials' results."""
 
 
@@ -75,15 +79,20 @@ def _log_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
     rows, unreadable = [], []
     for path in find_trial_logs(root):
         try:
-            result = read_result(path)
-            missing = [k for k in (*SETTING_KEYS, "object", "trial", "success") if k not in result]
-            if missing:
-                raise CorruptLogError(f"{path}: /result lacks {missing}")
-            noise = noise_of(yaml.safe_load(read_config_yaml(path) or "") or {})
-        except (CorruptLogError, OSError, yaml.YAMLError) as exc:
-            unreadable.append((path, str(exc)))
+            result = read_result(path)  # checks the whole file first (magic, CRCs, truncation)
+            config_yaml = read_config_yaml(path)
+            if config_yaml is None:
+                raise CorruptLogError(f"{path}: not a graspexp trial log (no graspexp metadata)")
+            config = yaml.safe_load(config_yaml)
+            if not isinstance(config, dict):
+                raise CorruptLogError(f"{path}: its recorded config is not a job config")
+            result_from_dict(result)
+        except (CorruptLogError, OSError, yaml.YAMLError, ValueError) as exc:
+            unreadable.append((path, str(exc) if str(path) in str(exc) else f"{path}: {exc}"))
             continue
-        rows.append(_row(result, path, noise))
+        row = _row(result, path, noise_of(config))
+        row[CONFIG_COLUMN] = result_config(config)
+        rows.append(row)
     return rows, unreadable
 
 
@@ -112,7 +121,7 @@ def collect(root: Path | str) -> Collected:
     df = pd.DataFrame(rows)
     duplicates: list[tuple[Path, Path]] = []
     if not df.empty:
-        df["success"] = df["success"].astype(str).str.lower().isin(("true", "1", "1.0"))
+        df["success"] = df["success"].astype(str).str.lower().isin(("true", "1", "1.0"))  # csv rows: text
         df["trial"] = df["trial"].astype(int)
         dup = df.duplicated(list(TRIAL_KEYS), keep="first")
         if dup.any():
@@ -120,4 +129,29 @@ def collect(root: Path | str) -> Collected:
             for _, r in df[dup].iterrows():
                 duplicates.append((Path(r["path"]), Path(first.loc[tuple(r[k] for k in TRIAL_KEYS)])))
             df = df[~dup].reset_index(drop=True)
+        check_one_config_per_cell(df)
+        df = df.drop(columns=CONFIG_COLUMN, errors="ignore")
     return Collected(root=root, results=df, unreadable=unreadable, duplicates=duplicates)
+
+
+class MixedConfigError(ValueError):
+    """Trials of one table cell were made with two configs (the message is one line naming the keys)."""
+
+
+def check_one_config_per_cell(df: pd.DataFrame) -> None:
+    """Raise :class:`MixedConfigError` if two logs of one cell (:data:`SETTING_KEYS` and
+    :data:`NOISE_KEYS`) recorded configs that differ on a key that can change a result and that both
+    record (a key only one records came with a newer graspexp: resume already compared it)."""
+    if CONFIG_COLUMN not in df:
+        return
+    logged = df[df[CONFIG_COLUMN].notna()]
+    for cell, group in logged.groupby(list(SETTING_KEYS + NOISE_KEYS), sort=False):
+        first, first_path = group[CONFIG_COLUMN].iloc[0], group["path"].iloc[0]
+        for config, path in zip(group[CONFIG_COLUMN].iloc[1:], group["path"].iloc[1:], strict=True):
+            keys = sorted(k for k in first.keys() & config.keys() if first[k] != config[k])
+            if keys:
+                raise MixedConfigError(
+                    f"{'/'.join(map(str, cell))} holds trials of two configs (differing keys: "
+                    f"{', '.join(keys[:6])}; {first_path} vs {path}); a table never merges configs: "
+                    "report their directories separately"
+                )

@@ -34,18 +34,19 @@ from omegaconf import DictConfig, OmegaConf
 from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
-from graspexp.config import BEFORE, validate
-from graspexp.core.outcome import FailureReason, TrialResult
+from graspexp.config import validate
+from graspexp.config.differences import config_differences
+from graspexp.core.outcome import FailureReason, TrialResult, result_from_dict
 from graspexp.core.seeding import trial_seed
 from graspexp.datasets import ObjectError, job_object, select_objects
 from graspexp.datasets.model import ObjectModel
 from graspexp.planning import plan
 from graspexp.quality import fc_min_mu
 from graspexp.record import (
+    TRIALS_DIR,
     CorruptLogError,
     iter_trial_logs,
     read_result,
-    read_trial,
     trial_log_path,
     trial_recorder,
 )
@@ -58,24 +59,12 @@ from graspexp.sim.shape import CollisionShape
 from graspexp.sim.trial import TrialContext, plain_config, run_trial
 
 log = logging.getLogger(__name__)
-RESULT_NEUTRAL_KEYS = (
-    "progress",  # the progress bar
-    "record",  # whether logs are written: a log that exists was recorded
-    "trials",  # which trials run, not what one gives (a trial's seed derives from its object and index)
-    "objects",
-    "dataset.objects",
-    "sim.cache_dir",  # where collision shapes are cached; entries are keyed by mesh content
-    "sim.prepare_workers",  # how many processes build the collision shapes, not what they build
-    "live",  # whether trials also stream to the Foxglove app
-    "live_port",
-)
-"""Config keys (and their sub-keys) that resume ignores when it compares a log's recorded config with the
-current one: they change what is shown or which trials run, never a trial's result. Add presentation-only
-keys here (e.g. live-streaming flags). ``hydra.*`` is not part of the job config and never compared."""
 LOCK_NAME = ".graspexp.lock"
 """Lock file in the job directory (``filelock``: flock(2), which Linux maps to POSIX locks on NFS, so it
 holds across the nodes of a cluster; the kernel or the NFS server drops it when the holder dies)."""
 HOLDER_NAME = ".graspexp.lock.holder"
+QUARANTINE_DIR = ".quarantine"
+"""Folder of ``trials/`` where resume moves files that are not usable trial logs (never deleted)."""
 """Who holds the lock (host, pid, start time, command), for the message of a second run."""
 PACKAGES = ("graspexp", "sapien", "numpy", "scikit-learn", "trimesh", "coacd", "mcap", "hydra-core")
 
@@ -237,7 +226,7 @@ def run_object_trials(
     for i in range(cfg.trials):
         path = trial_log_path(run_dir, object_name, i)
         seed = trial_seed(plain, object_name, i)
-        result = _finished(path)
+        result = _finished(path, run_dir, object_name, i)
         if result is None:
             try:
                 path.parent.mkdir(parents=True, exist_ok=True)
@@ -275,84 +264,56 @@ def run_object_trials(
     return results
 
 
-def _finished(path: Path) -> TrialResult | None:
-    """The result of a complete log at ``path``; None if absent, partial, corrupt or an ``error`` trial
-    (then it is redone)."""
+def _finished(path: Path, run_dir: Path, object_name: str, trial: int) -> TrialResult | None:
+    """The result of a complete log at ``path``; None if absent. A log whose /result is unreadable or not
+    a valid result of this trial, and a trial that ended in ``error``, are moved aside
+    (:func:`quarantine`) and redone."""
     if not path.exists():
         return None
     try:
-        result = TrialResult.from_dict(read_result(path))
-    except CorruptLogError as exc:
-        log.warning("re-running trial: %s", exc)
-        path.unlink()
+        result = result_from_dict(read_result(path))
+        if (result.object, result.trial) != (object_name, trial):
+            raise ValueError(f"its result is of {result.object} trial {result.trial}")
+    except (CorruptLogError, ValueError) as exc:
+        quarantine(path, run_dir, f"re-running trial: {exc}")
         return None
     if result.reason == FailureReason.ERROR.value:
-        log.info("re-running trial %s: it ended in an error (%s)", path, result.error)
-        path.unlink()
+        quarantine(path, run_dir, f"re-running trial: it ended in an error ({result.error})")
         return None
     return result
 
 
-def _flatten(node: object, prefix: str = "") -> dict[str, object]:
-    if isinstance(node, dict):
-        out: dict[str, object] = {}
-        for k, v in node.items():
-            out.update(_flatten(v, f"{prefix}{k}."))
-        return out
-    return {prefix[:-1]: node}
-
-
-def _neutral(key: str) -> bool:
-    return any(key == n or key.startswith(n + ".") for n in RESULT_NEUTRAL_KEYS)
-
-
-_NO_DEFAULT = object()
-
-
-def _value_before(cfg: DictConfig, key: str) -> object:
-    """The value dotted ``key`` had before graspexp added it: its schema field's ``metadata["before"]``
-    (:data:`graspexp.config.BEFORE`) when the key came with a new behaviour, else its default; else
-    ``_NO_DEFAULT``."""
-    parent, _, leaf = key.rpartition(".")
-    node = OmegaConf.select(cfg, parent) if parent else cfg
-    schema = OmegaConf.get_type(node) if isinstance(node, DictConfig) else None
-    for f in dataclasses.fields(schema) if dataclasses.is_dataclass(schema) else ():
-        if f.name != leaf:
-            continue
-        if BEFORE in f.metadata:
-            return f.metadata[BEFORE]
-        if f.default is not dataclasses.MISSING:
-            return f.default
-        if f.default_factory is not dataclasses.MISSING:
-            return f.default_factory()
-    return _NO_DEFAULT
-
-
-def config_differences(recorded_yaml: str, cfg: DictConfig) -> dict[str, tuple[object, object]]:
-    """dotted key -> (value in the log, value now) for every key that affects a result and differs; a key
-    absent on one side shows as ``<absent>``. A key the log lacks is not a difference when it now has the
-    value the code had before the key was added (:func:`_value_before`)."""
-    old = _flatten(OmegaConf.to_container(OmegaConf.create(recorded_yaml), resolve=True))
-    new = _flatten(OmegaConf.to_container(cfg, resolve=True))
-    absent = "<absent>"
-    return {
-        k: (old.get(k, absent), new.get(k, absent))
-        for k in sorted(old.keys() | new.keys())
-        if not _neutral(k)
-        and old.get(k, absent) != new.get(k, absent)
-        and not (k not in old and k in new and new[k] == _value_before(cfg, k))
-    }
+def quarantine(path: Path, run_dir: Path, why: str) -> Path:
+    """Move ``path`` out of ``trials/`` into ``trials/.quarantine/<object>/<name>.<UTC time>`` (never
+    deleted: a foreign or damaged file may be someone's data) and log ``why`` with where it went."""
+    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y%m%dT%H%M%S%fZ")
+    target = run_dir / TRIALS_DIR / QUARANTINE_DIR / path.parent.name / f"{path.name}.{stamp}"
+    target.parent.mkdir(parents=True, exist_ok=True)
+    os.replace(path, target)
+    log.warning("%s; %s moved to %s", why, path, target)
+    return target
 
 
 def check_resumable(cfg: DictConfig, run_dir: Path) -> None:
-    """Raise RunError if a finished log in ``run_dir`` was made with a different config (see
-    :data:`RESULT_NEUTRAL_KEYS`); partial and unreadable logs are left to be redone."""
+    """Raise RunError if a graspexp log in ``run_dir`` was made with a different config (see
+    :mod:`graspexp.config.differences`); then move aside (:func:`quarantine`) the files in ``trials/`` that
+    are not graspexp trial logs (no graspexp metadata, unreadable metadata): nothing is moved when the run
+    is refused. Partial logs and damaged results are left to :func:`_finished`."""
+    foreign = []
     for path in iter_trial_logs(run_dir):
         try:
-            recorded = read_trial(path).metadata.get("config_yaml", "")
-        except CorruptLogError:
+            meta = read_metadata(path)
+        except CorruptLogError as exc:
+            foreign.append((path, str(exc)))
             continue
-        diff = config_differences(recorded, cfg)
+        if not meta or "config_yaml" not in meta:
+            foreign.append((path, f"{path}: not a graspexp trial log (no graspexp metadata)"))
+            continue
+        try:
+            diff = config_differences(meta["config_yaml"], cfg)
+        except Exception as exc:  # a recorded config that is not YAML of a job config
+            foreign.append((path, f"{path}: unreadable recorded config ({type(exc).__name__})"))
+            continue
         if diff:
             keys = sorted(diff, key=lambda k: ("." in k and not k.endswith(".name"), k))  # choices first
             shown = "; ".join(f"{k}: {diff[k][0]!r} in the log, {diff[k][1]!r} now" for k in keys[:4])
@@ -361,6 +322,8 @@ def check_resumable(cfg: DictConfig, run_dir: Path) -> None:
                 f"({path.relative_to(run_dir)}: {shown}); resume only reuses logs of the same config: "
                 f"choose another output directory (hydra.run.dir / hydra.sweep.dir) or delete {run_dir / 'trials'}"
             )
+    for path, why in foreign:
+        quarantine(path, run_dir, why)
 
 
 @contextmanager
@@ -405,6 +368,22 @@ def summarize(df: pd.DataFrame) -> pd.DataFrame:
     return table
 
 
+def kept_results(run_dir: Path, done: set[tuple[str, int]]) -> list[TrialResult]:
+    """The results of the directory's other complete logs (same config: :func:`check_resumable`), e.g. the
+    trials 3-9 a run with ``trials=3`` keeps from an earlier ``trials=10``: results.csv and summary.md
+    describe every trial the directory holds, never fewer."""
+    out = []
+    for path in iter_trial_logs(run_dir):
+        key = (path.parent.name, int(path.stem)) if path.stem.isdigit() else None
+        if key is None or key in done:
+            continue
+        try:
+            out.append(result_from_dict(read_result(path)))
+        except (CorruptLogError, ValueError):
+            continue  # a damaged log is moved aside when its trial is run again
+    return out
+
+
 def object_notes(models: dict[str, LoadedObject], unusable: dict[str, str]) -> str:
     """The summary's lines on what was assumed for each object and why an object could not be used
     ("" when there is nothing to say)."""
@@ -444,6 +423,7 @@ def _run(cfg: DictConfig, run_dir: Path) -> float:
     ) as bar:
         for name in objects:
             results.extend(run_object_trials(cfg, name, run_dir, bar, models.get(name) or unusable[name]))
+    results += kept_results(run_dir, {(r.object, r.trial) for r in results})
     df = pd.DataFrame([r.to_dict() for r in results])
     df.to_csv(run_dir / "results.csv", index=False)
     table = summarize(df)

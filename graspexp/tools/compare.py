@@ -7,8 +7,9 @@ and prints the Markdown. Exit status 2 when DIR holds no readable trial log.
 import sys
 from pathlib import Path
 
+from graspexp.report.collect import MixedConfigError
 from graspexp.report.compare import write_comparison
-from graspexp.tools.cli import tool_parser
+from graspexp.tools.cli import fail, tool_parser
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -19,7 +20,15 @@ def main(argv: list[str] | None = None) -> int:
     if not args.dir.is_dir():
         print(f"graspexp compare: error: {args.dir} is not a directory", file=sys.stderr)
         return 2
-    md, table, _ = write_comparison(args.dir, args.out)
+    try:
+        md, table, _ = write_comparison(args.dir, args.out)
+    except MixedConfigError as exc:
+        fail(str(exc), "graspexp compare")
+    except OSError as exc:
+        fail(
+            f"cannot write the comparison: {exc.strerror or exc}: {exc.filename}; choose --out",
+            "graspexp compare",
+        )
     print(md, end="")
     if table.empty:
         print(f"graspexp compare: error: no readable trial log below {args.dir}", file=sys.stderr)

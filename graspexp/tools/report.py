@@ -1,14 +1,22 @@
 """``python -m graspexp report DIR [--out OUT]``: tables and figures from the trial logs below DIR.
 
 DIR is a run directory or a multirun (sweep) directory; every ``trials/<object>/<NNN>.mcap`` below it
-is read. The report goes to ``DIR/report/`` (or OUT) and its Markdown is printed.
+is read. The report goes to ``DIR/report/`` (or OUT) and its Markdown is printed. Exit status: 0; 1 when
+some logs could not be read (the report lists them); 2 when there is nothing to report, the directory mixes
+two configs in one table cell, or the report cannot be written.
 """
 
 import sys
 from pathlib import Path
 
 from graspexp.report.build import build_report, write_report
+from graspexp.report.collect import MixedConfigError
 from graspexp.tools.cli import tool_parser
+
+
+def _error(message: str) -> int:
+    print(f"graspexp report: error: {message}", file=sys.stderr)
+    return 2
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -20,15 +28,28 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = parser.parse_args(argv)
     if not args.dir.is_dir():
-        print(f"graspexp report: error: {args.dir} is not a directory", file=sys.stderr)
-        return 2
-    report = build_report(args.dir)
+        return _error(f"{args.dir} is not a directory")
+    try:
+        report = build_report(args.dir)
+    except MixedConfigError as exc:
+        return _error(str(exc))
     if report.collected.results.empty and not report.collected.unreadable:
-        print(f"graspexp report: error: no trial logs (trials/*/*.mcap) below {args.dir}", file=sys.stderr)
-        return 2
+        return _error(f"no trial logs (trials/*/*.mcap) below {args.dir}")
     out = args.out if args.out is not None else args.dir / "report"
-    print(write_report(report, out, gallery_per_reason=args.gallery))
+    try:
+        print(write_report(report, out, gallery_per_reason=args.gallery))
+    except OSError as exc:
+        return _error(
+            f"cannot write the report to {out}: {exc.strerror or exc}; choose another folder with --out"
+        )
     print(f"\nreport written to {out}", file=sys.stderr)
+    if report.collected.unreadable:
+        n = len(report.collected.unreadable)
+        print(
+            f"graspexp report: {n} log(s) could not be read; they are listed in {out / 'report.md'}",
+            file=sys.stderr,
+        )
+        return 1
     return 0
 
 

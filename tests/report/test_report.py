@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import compose_cfg
+from conftest import compose_cfg, foreign_log
 
 from graspexp.core.outcome import FailureReason, TrialResult
 from graspexp.datasets import dataset_objects
@@ -241,7 +241,7 @@ def test_corrupt_and_unfinished_logs_are_named_not_dropped(sweep_dir: Path, tmp_
     (run / "010.mcap").write_bytes(good[: len(good) // 2])  # truncated
     (run / "011.mcap").write_bytes(b"not an mcap file at all")  # garbage
     (run / "012.mcap.partial").write_bytes(good[:100])  # writer killed mid-trial
-    assert report_main([str(root)]) == 0
+    assert report_main([str(root)]) == 1  # written, but not every log was read
     text = capsys.readouterr().out
     section = text[text.index("## Unreadable logs (3)") :]
     for name in ("010.mcap", "011.mcap", "012.mcap.partial"):
@@ -252,6 +252,44 @@ def test_corrupt_and_unfinished_logs_are_named_not_dropped(sweep_dir: Path, tmp_
     # the readable logs are still counted exactly as before
     t1 = build_report(root).tables[0]
     assert _cell(t1, "Mug", "collab", "z")["n"] == 10
+
+
+@pytest.mark.parametrize(
+    "meta, change, reason",
+    [
+        (None, {}, "not a graspexp trial log (no graspexp metadata)"),  # a foreign MCAP with a /result
+        ({"config_yaml": "{}"}, {"success": "false"}, "success='false' is not"),
+        ({"config_yaml": "{}"}, {"trial": "abc"}, "trial='abc' is not"),
+        ({"config_yaml": "- 1"}, {}, "its recorded config is not a job config"),
+    ],
+)
+def test_foreign_or_forged_logs_are_unreadable_not_counted(sweep_dir, tmp_path, meta, change, reason) -> None:
+    import shutil
+
+    root = tmp_path / "sweep"
+    shutil.copytree(sweep_dir / "dataset=ycb,mode=collab,rot=z", root)
+    result = {**_result("ycb", "025_mug", "collab", "z", 10, None, 0.05), **change}
+    path = root / "trials" / "025_mug" / "010.mcap"
+    if meta is None:
+        foreign_log(path, result)
+    else:
+        with TrialRecorder(path, meta) as rec:
+            rec.result(0.0, result)
+    col = collect(root)
+    assert len(col.results) == 20 and [(p.name, r) for p, r in col.unreadable if reason in r] == [
+        ("010.mcap", col.unreadable[0][1])
+    ]
+
+
+def test_a_cell_with_two_configs_is_refused_in_one_line(tmp_path: Path, capsys) -> None:
+    for i, gripper in enumerate(("rg2", "panda")):
+        meta = {"config_yaml": f"gripper: {{name: {gripper}}}\ntrials: {i + 1}\n"}
+        with TrialRecorder(tmp_path / f"run{i}" / "trials" / "025_mug" / f"{i:03d}.mcap", meta) as rec:
+            rec.result(0.0, _result("ycb", "025_mug", "collab", "z", i, None, 0.05))
+    assert report_main([str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("graspexp report: error: ycb/optimal/collab/z/0.0/0.0 holds trials of two configs")
+    assert "differing keys: gripper.name;" in err and "\n" not in err
 
 
 def test_duplicate_trials_are_counted_once_and_named(sweep_dir: Path, tmp_path: Path) -> None:

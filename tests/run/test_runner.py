@@ -13,14 +13,15 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-from conftest import compose_cfg
+from conftest import compose_cfg, foreign_log
 from omegaconf import OmegaConf
 from omegaconf.errors import ReadonlyConfigError
 
+from graspexp.config.differences import config_differences
 from graspexp.core.outcome import FailureReason, TrialResult
 from graspexp.datasets import DatasetError
 from graspexp.record import TrialRecorder, read_result
-from graspexp.run.runner import config_differences, job_lock, job_metadata, run_in_dir, summarize
+from graspexp.run.runner import job_lock, job_metadata, run_in_dir, summarize
 
 REPO = Path(__file__).resolve().parents[2]
 BASE = ("objects=[can]", "trials=1")
@@ -155,6 +156,36 @@ def test_error_trial_is_redone_on_resume(run_copy: Path) -> None:
     redone = read_result(path)
     assert (redone["reason"], redone["success"]) == (old.reason, old.success)
     assert pd.read_csv(run_copy / "results.csv")["success"].tolist() == [old.success]
+    (kept,) = (run_copy / "trials" / ".quarantine" / "can").iterdir()  # the error log is kept, not deleted
+    assert kept.name.startswith("000.mcap.") and read_result(kept)["reason"] == "error"
+
+
+@pytest.mark.slow
+def test_foreign_and_damaged_files_in_trials_are_moved_aside_never_reused_or_deleted(run_copy: Path) -> None:
+    good = read_result(run_copy / "trials" / "can" / "000.mcap")
+    foreign = run_copy / "trials" / "can" / "001.mcap"
+    foreign_log(foreign, {**good, "trial": 1, "success": True, "reason": None})
+    forged = run_copy / "trials" / "box" / "000.mcap"
+    forged.parent.mkdir()
+    forged.write_bytes(b"\x89MCAP0\r\n not a log")
+    proc = _run_job(run_copy, "objects=[can]", "trials=2")
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    quarantined = sorted(
+        p.relative_to(run_copy / "trials" / ".quarantine")
+        for p in (run_copy / "trials" / ".quarantine").rglob("*.mcap.*")
+    )
+    assert [(q.parent.name, q.name.split(".")[0]) for q in quarantined] == [("box", "000"), ("can", "001")]
+    assert read_result(run_copy / "trials" / "can" / "001.mcap")["trial"] == 1  # trial 1 was run for real
+    results = pd.read_csv(run_copy / "results.csv")
+    assert sorted(zip(results["object"], results["trial"], strict=True)) == [("can", 0), ("can", 1)]
+
+
+@pytest.mark.slow
+def test_a_rerun_with_fewer_trials_keeps_every_trial_in_the_table(run_copy: Path) -> None:
+    assert _run_job(run_copy, "objects=[can]", "trials=2").returncode == 0
+    assert _run_job(run_copy, "objects=[can]", "trials=1").returncode == 0
+    assert pd.read_csv(run_copy / "results.csv")["trial"].tolist() == [0, 1]
+    assert "|        2 |" in (run_copy / "summary.md").read_text()
 
 
 @pytest.mark.slow
