@@ -4,9 +4,9 @@ the pads.
 Each kernel is a plain serial loop (no threads: on a shared 2-core machine ``prange`` was 20x slower) that
 numba compiles on first use and caches on disk, so a process pays the compilation once per machine and
 afterwards only numba's import and the cache load (README, "Development"). The cache lives in
-``$NUMBA_CACHE_DIR`` when set, else in ``numba/`` under the graspexp cache folder (``$GRASPEXP_CACHE``, else
-``~/.cache/graspexp``), never beside the installed package, which may be read-only. When no writable folder
-is found the kernels still work, compiled afresh in every process.
+``$NUMBA_CACHE_DIR`` when set, else in a per-user folder (:func:`numba_cache_dir`, mode 0700), never in the
+shared ``$GRASPEXP_CACHE`` nor beside the installed package. When no private writable folder is found the
+kernels still work, compiled afresh in every process.
 
 The public wrappers live with their meaning: :func:`graspexp.planning.cost.all_path_costs` and
 :func:`~graspexp.planning.cost.distance_term`, :func:`graspexp.planning.clusters.segment` and
@@ -15,22 +15,37 @@ The public wrappers live with their meaning: :func:`graspexp.planning.cost.all_p
 """
 
 import os
+import stat
 import tempfile
+import warnings
 from pathlib import Path
 
 import numba
 import numpy as np
 
 
-def graspexp_cache_dir() -> Path:
-    """graspexp's cache folder: ``$GRASPEXP_CACHE``, else ``~/.cache/graspexp``."""
-    return Path(os.environ.get("GRASPEXP_CACHE") or Path.home() / ".cache" / "graspexp")
+def numba_cache_dir() -> Path:
+    """The per-user folder of numba's compiled kernels: ``$XDG_CACHE_HOME/graspexp/numba``, else
+    ``~/.cache/graspexp/numba``; never ``$GRASPEXP_CACHE``, which may be shared by a cluster's users
+    (numba's cache index files are pickles: whoever can write them runs code in the next process)."""
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "graspexp" / "numba"
 
 
-def _writable(folder: Path) -> bool:
-    """True when ``folder`` exists (created here if needed) and a file can be written in it."""
+def _private(folder: Path) -> bool:
+    """True when ``folder`` exists (created ``0700`` here if needed), is owned by this user and writable by
+    no one else, and a file can be written in it."""
     try:
-        folder.mkdir(parents=True, exist_ok=True)
+        folder.mkdir(mode=0o700, parents=True, exist_ok=True)
+        st = folder.stat()
+        if st.st_uid != os.getuid() or st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+            warnings.warn(
+                f"numba cache {folder} is not private to this user (owner or group/other write access); "
+                "compiling the planner's kernels in this process instead (chmod 700 it, or set NUMBA_CACHE_DIR)",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+            return False
         tempfile.TemporaryFile(dir=folder).close()
     except OSError:
         return False
@@ -38,10 +53,12 @@ def _writable(folder: Path) -> bool:
 
 
 def _enable_disk_cache() -> bool:
-    """Point numba's cache at a writable folder (module doc); False when there is none."""
-    if not numba.config.CACHE_DIR:  # $NUMBA_CACHE_DIR wins when the user set it
-        numba.config.CACHE_DIR = str(graspexp_cache_dir() / "numba")
-    return _writable(Path(numba.config.CACHE_DIR))
+    """Point numba's cache at the per-user folder (module doc); False when it is not usable. A
+    ``$NUMBA_CACHE_DIR`` set by the user wins and is used as given."""
+    if numba.config.CACHE_DIR:
+        return True
+    numba.config.CACHE_DIR = str(numba_cache_dir())
+    return _private(Path(numba.config.CACHE_DIR))
 
 
 _CACHE = _enable_disk_cache()

@@ -16,6 +16,7 @@ With ``record=false`` no log is written (faster, but nothing to replay and nothi
 import dataclasses
 import datetime
 import errno
+import hashlib
 import logging
 import os
 import platform
@@ -38,7 +39,7 @@ from graspexp.config import validate
 from graspexp.config.differences import config_differences
 from graspexp.core.outcome import FailureReason, TrialResult, result_from_dict
 from graspexp.core.seeding import trial_seed
-from graspexp.datasets import ObjectError, job_object, select_objects
+from graspexp.datasets import ObjectError, job_object, resolve_root, select_objects
 from graspexp.datasets.model import ObjectModel
 from graspexp.planning import plan
 from graspexp.quality import fc_min_mu
@@ -100,10 +101,34 @@ class LoadedObject:
 
 
 def job_metadata(cfg: DictConfig) -> dict[str, str]:
-    """The part of every trial's MCAP metadata that is the same for the whole job."""
+    """The part of every trial's MCAP metadata that is the same for the whole job: the config, the seed,
+    the data root it read, the package versions and the machine (:func:`machine_fingerprint`)."""
     meta = {"config_yaml": OmegaConf.to_yaml(cfg, resolve=True), "global_seed": str(cfg.seed)}
+    meta["data_root"] = str(resolve_root(cfg.dataset).resolve())
     meta.update({f"version.{k}": v for k, v in package_versions().items()})
+    meta.update({f"machine.{k}": v for k, v in machine_fingerprint().items()})
     return meta
+
+
+def machine_fingerprint() -> dict[str, str]:
+    """What a trial's floating point may depend on besides the code: CPU model, its instruction-set flags
+    (a hash: PhysX and numba pick vector paths by them), OS and architecture."""
+    cpu, flags = platform.processor() or "unknown", ""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            key, _, value = line.partition(":")
+            if key.strip() == "model name" and cpu in ("unknown", "", platform.machine()):
+                cpu = value.strip()
+            elif key.strip() in ("flags", "Features") and not flags:
+                flags = " ".join(sorted(value.split()))
+    except OSError:
+        pass
+    return {
+        "cpu": cpu,
+        "cpu_flags_sha256": hashlib.sha256(flags.encode()).hexdigest()[:16],
+        "platform": platform.platform(),
+        "arch": platform.machine(),
+    }
 
 
 def _metadata(job_meta: dict[str, str], loaded: LoadedObject, trial: int, seed: int) -> dict[str, str]:
@@ -118,6 +143,7 @@ def _metadata(job_meta: dict[str, str], loaded: LoadedObject, trial: int, seed: 
         "mesh_source": loaded.model.source,
         "mesh_sha256": loaded.model.mesh_sha256,
         "collision_method": loaded.hulls.method,
+        "collision_key": loaded.hulls.key,
         "object_notes": "\n".join(loaded.notes),
     }
 

@@ -17,10 +17,12 @@ an OBJ file beside the cache entry: SAPIEN cooks a mesh file once per process an
 import dataclasses
 import hashlib
 import json
+import logging
 import os
 import sys
 import tempfile
 from contextlib import contextmanager
+from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 import numpy as np
@@ -31,6 +33,7 @@ from graspexp.config import SimConfig
 from graspexp.sim.collision_accuracy import shape_accuracy, surface_points
 from graspexp.sim.shape import CollisionShape
 
+log = logging.getLogger(__name__)
 METHODS = ("mesh", "coacd", "vhacd")
 FALLBACK_METHOD = "coacd"
 """The method an object falls back to when ``mesh`` cannot repair it (a convex decomposition needs no
@@ -83,41 +86,100 @@ def shape_params(cfg: SimConfig) -> dict:
     raise ValueError(f"sim.collision_method={method!r} is invalid: expected one of {', '.join(METHODS)}")
 
 
+CACHE_FORMAT = 2
+"""Version of the cache entries' layout and builders, part of every key: bump it when a builder changes."""
+METHOD_LIBRARIES = {
+    "mesh": ("pymeshfix", "fast-simplification", "trimesh"),
+    "coacd": ("coacd", "trimesh"),
+    "vhacd": ("vhacdx", "trimesh"),
+}
+"""The libraries whose versions are part of a method's cache key (an upgrade rebuilds the shapes)."""
+
+
+def _library_versions(method: str) -> dict[str, str]:
+    out = {}
+    for name in METHOD_LIBRARIES[method]:
+        try:
+            out[name] = version(name)
+        except PackageNotFoundError:
+            out[name] = "absent"
+    return out
+
+
 def mesh_key(mesh: trimesh.Trimesh, params: dict) -> str:
-    """Content hash of the mesh geometry and the shape parameters."""
+    """Content hash of the mesh geometry, the shape parameters, :data:`CACHE_FORMAT` and the versions of the
+    method's libraries (the cache file's name, and the ``collision_key`` of a trial's log)."""
     h = hashlib.sha256()
     h.update(np.ascontiguousarray(mesh.vertices, dtype=np.float64).tobytes())
     h.update(np.ascontiguousarray(mesh.faces, dtype=np.int64).tobytes())
-    h.update(json.dumps(params, sort_keys=True).encode())
+    versioned = {**params, "cache_format": CACHE_FORMAT, "libraries": _library_versions(params["method"])}
+    h.update(json.dumps(versioned, sort_keys=True).encode())
     return h.hexdigest()[:32]
 
 
 def is_cached(mesh: trimesh.Trimesh, cfg: SimConfig) -> bool:
-    """Whether :func:`collision_shape` would read ``mesh``'s shape from the cache."""
+    """Whether :func:`collision_shape` would read ``mesh``'s shape from the cache (an intact entry)."""
     params = shape_params(cfg)
-    return (cache_dir(cfg) / f"{mesh_key(mesh, params)}.npz").exists()
+    return _read_entry(cache_dir(cfg) / f"{mesh_key(mesh, params)}.npz") is not None
 
 
 def collision_shape(mesh: trimesh.Trimesh, cfg: SimConfig) -> CollisionShape:
     """The collision shape of ``mesh`` (object frame, metres) for ``cfg.collision_method``: from the
     cache, or built and cached. A mesh that is already convex (within 0.1 % of its hull volume) is its
-    own single hull under every method."""
+    own single hull under every method.
+
+    Every cache entry records the SHA-256 of its parts (and of the OBJ file SAPIEN cooks); an entry or OBJ
+    that does not match (damaged, cut, edited) is rebuilt and rewritten, never used.
+    """
     params = shape_params(cfg)
-    path = cache_dir(cfg) / f"{mesh_key(mesh, params)}.npz"
-    if not path.exists():
+    key = mesh_key(mesh, params)
+    path = cache_dir(cfg) / f"{key}.npz"
+    entry = _read_entry(path)
+    if entry is None:
+        if path.exists():
+            log.warning("collision cache entry %s does not match its checksum; rebuilding it", path)
         convex, parts = _build(mesh, params)
+        obj_text = b"" if convex else _obj_text(parts[0])
         arrays = {f"{kind}_{i}": a for i, (v, f) in enumerate(parts) for kind, a in (("v", v), ("f", f))}
-        _write_atomic(path, lambda fh: np.savez(fh, convex=convex, **arrays))
-    with np.load(path) as data:
-        convex = bool(data["convex"])
-        parts = tuple((data[f"v_{i}"], data[f"f_{i}"]) for i in range((len(data.files) - 1) // 2))
+        digests = {"sha256": _parts_digest(convex, parts), "obj_sha256": hashlib.sha256(obj_text).hexdigest()}
+        _write_atomic(path, lambda fh: np.savez(fh, convex=convex, n_parts=len(parts), **digests, **arrays))
+        entry = (convex, tuple(parts), digests["obj_sha256"])
+    convex, parts, obj_sha256 = entry
     if convex:
-        return CollisionShape(params["method"], parts, True)
+        return CollisionShape(params["method"], parts, True, key=key)
     obj = path.with_suffix(".obj")  # OBJ: SAPIEN 3.0.3 crashes cooking some binary PLY files (16k faces)
-    if not obj.exists():
-        text = trimesh.Trimesh(*parts[0], process=False).export(file_type="obj", include_normals=False)
-        _write_atomic(obj, lambda fh: fh.write(text.encode()))
-    return CollisionShape(params["method"], parts, False, obj)
+    if not obj.is_file() or hashlib.sha256(obj.read_bytes()).hexdigest() != obj_sha256:
+        if obj.exists():
+            log.warning("collision cache file %s does not match its checksum; rewriting it", obj)
+        text = _obj_text(parts[0])
+        _write_atomic(obj, lambda fh: fh.write(text))
+    return CollisionShape(params["method"], parts, False, obj, key=key)
+
+
+def _obj_text(part: tuple[np.ndarray, np.ndarray]) -> bytes:
+    return trimesh.Trimesh(*part, process=False).export(file_type="obj", include_normals=False).encode()
+
+
+def _parts_digest(convex: bool, parts) -> str:
+    h = hashlib.sha256(b"convex" if convex else b"mesh")
+    for v, f in parts:
+        h.update(np.ascontiguousarray(v, dtype=np.float32).tobytes())
+        h.update(np.ascontiguousarray(f, dtype=np.int64).tobytes())
+    return h.hexdigest()
+
+
+def _read_entry(path: Path) -> tuple[bool, tuple, str] | None:
+    """(convex, parts, OBJ checksum) of an intact cache entry; None when absent, unreadable or damaged."""
+    try:
+        with np.load(path) as data:
+            n, convex = int(data["n_parts"]), bool(data["convex"])
+            parts = tuple((data[f"v_{i}"], data[f"f_{i}"]) for i in range(n))
+            digest, obj_sha256 = str(data["sha256"]), str(data["obj_sha256"])
+    except FileNotFoundError:
+        return None
+    except Exception:  # a truncated zip, a missing array, a bad header: rebuilt by the caller
+        return None
+    return (convex, parts, obj_sha256) if _parts_digest(convex, parts) == digest else None
 
 
 def shape_with_fallback(mesh: trimesh.Trimesh, cfg: SimConfig) -> tuple[CollisionShape, str]:

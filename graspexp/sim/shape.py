@@ -20,6 +20,8 @@ class CollisionShape:
     """True: every part is a convex hull (PhysX convex shapes). False: one closed triangle mesh."""
     mesh_file: Path | None = None
     """The OBJ file of the closed mesh that SAPIEN cooks once per process; None for hulls."""
+    key: str = ""
+    """The cache key it was built under (mesh content, method parameters, library versions); "" if uncached."""
 
     def meshes(self) -> list[trimesh.Trimesh]:
         """The parts as triangle meshes (object frame, metres)."""

@@ -142,8 +142,10 @@ def test_kmeans_kernel_matches_the_numpy_twin_on_blobs():
 
 
 @pytest.mark.slow
-def test_kernel_cache_goes_to_the_graspexp_cache_and_survives_an_unwritable_one(tmp_path):
-    """A subprocess per case: numba's cache folder is fixed when the kernels module is imported."""
+def test_kernel_cache_is_per_user_private_and_survives_an_unusable_one(tmp_path):
+    """A subprocess per case: numba's cache folder is fixed when the kernels module is imported. The
+    kernels are cached under XDG_CACHE_HOME (mode 0700), never under the shared GRASPEXP_CACHE; a folder
+    others can write, or one that cannot be made, is not used (compiled in the process instead)."""
     script = (
         "import numba, numpy as np\n"
         "from graspexp.config import CostConfig\n"
@@ -155,19 +157,24 @@ def test_kernel_cache_goes_to_the_graspexp_cache_and_survives_an_unwritable_one(
     env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
     blocker = tmp_path / "a_file"
     blocker.write_text("")
-    for cache, writable in ((tmp_path / "cache", True), (blocker / "cache", False)):
+    shared = tmp_path / "shared"
+    (shared / "graspexp" / "numba").mkdir(parents=True)
+    (shared / "graspexp" / "numba").chmod(0o777)
+    for xdg, usable in ((tmp_path / "home", True), (blocker, False), (shared, False)):
         proc = subprocess.run(
             [sys.executable, "-c", script],
-            env={**env, "GRASPEXP_CACHE": str(cache)},
+            env={**env, "XDG_CACHE_HOME": str(xdg), "GRASPEXP_CACHE": str(tmp_path / "graspexp-cache")},
             capture_output=True,
             text=True,
             timeout=300,
         )
         assert proc.returncode == 0, proc.stderr
         flag, folder, total = proc.stdout.split()
-        assert (flag, folder) == (str(writable), str(cache / "numba"))
+        assert (flag, folder) == (str(usable), str(xdg / "graspexp" / "numba"))
         assert float(total) == 15.0  # 3 paths x 5 points, each term capped at 1 (Y = sqrt(2), r = 1)
-        assert bool(list((cache / "numba").rglob("*.nbi"))) is writable
+        assert bool(list((xdg / "graspexp" / "numba").rglob("*.nbi"))) is usable
+        assert not (tmp_path / "graspexp-cache" / "numba").exists()
+    assert (tmp_path / "home" / "graspexp" / "numba").stat().st_mode & 0o777 == 0o700
 
 
 # --- the whole plan on the real meshes ---

@@ -180,3 +180,39 @@ def test_mesh_shape_keeps_every_sizeable_part(tmp_path):
     shape = collision_shape(mesh, SimConfig(cache_dir=str(tmp_path)))
     pts, _ = trimesh.sample.sample_surface(mesh, 3000, seed=0)
     assert np.percentile(uncovered_m(pts, shape), 90) < 2e-4
+
+
+@pytest.mark.parametrize("damage", ["truncate_npz", "garbage_npz", "cut_obj"])
+def test_a_damaged_cache_entry_is_rebuilt_never_used(tmp_path, damage):
+    from graspexp.sim.collision_shapes import mesh_key
+
+    cfg = SimConfig(cache_dir=str(tmp_path), collision_method="mesh")
+    mesh = trimesh.creation.annulus(r_min=0.02, r_max=0.04, height=0.06, sections=32)  # concave: a ring
+    first = collision_shape(mesh, cfg)
+    assert not first.convex and first.key == mesh_key(mesh, shape_params(cfg))
+    npz = tmp_path / "collision" / f"{first.key}.npz"
+    obj = npz.with_suffix(".obj")
+    good_obj = obj.read_bytes()
+    if damage == "truncate_npz":
+        npz.write_bytes(npz.read_bytes()[:100])
+    elif damage == "garbage_npz":
+        npz.write_bytes(b"PK\x03\x04 not a zip")
+    else:
+        lines = obj.read_text().splitlines()
+        faces = [i for i, ln in enumerate(lines) if ln.startswith("f ")]
+        obj.write_text("\n".join(ln for i, ln in enumerate(lines) if i not in set(faces[::2])) + "\n")
+    assert damage == "cut_obj" or not is_cached(mesh, cfg)
+    again = collision_shape(mesh, cfg)
+    for (v0, f0), (v1, f1) in zip(first.parts, again.parts, strict=True):
+        np.testing.assert_array_equal(v0, v1)
+        np.testing.assert_array_equal(f0, f1)
+    assert obj.read_bytes() == good_obj and is_cached(mesh, cfg)
+
+
+def test_the_cache_key_holds_the_library_versions(monkeypatch):
+    from graspexp.sim import collision_shapes
+
+    mesh, params = _sphere(), shape_params(SimConfig())
+    key = collision_shapes.mesh_key(mesh, params)
+    monkeypatch.setattr(collision_shapes, "_library_versions", lambda method: {"pymeshfix": "99"})
+    assert collision_shapes.mesh_key(mesh, params) != key
