@@ -185,7 +185,9 @@ def _rigid_group(link: str, joints: dict[str, _Joint]) -> dict[str, np.ndarray]:
     return out
 
 
-def _finger_joints(names: tuple[str, ...] | None, joints: dict[str, _Joint], links, urdf: Path) -> list[_Joint]:
+def _finger_joints(
+    names: tuple[str, ...] | None, joints: dict[str, _Joint], links, urdf: Path
+) -> list[_Joint]:
     """The two finger joints: those named, else the prismatic joints whose child carries collision geometry."""
     if names is not None:
         if len(names) != 2:
@@ -254,18 +256,24 @@ def load_hand(
         stat = path.stat()
     except OSError:
         raise UrdfError(f"{path} not found") from None
-    return _load_hand(path, stat.st_mtime_ns, stat.st_size, palm_link, finger_joints, approach_axis, tcp_m, tcp_from_tip_m)
+    return _load_hand(
+        path, stat.st_mtime_ns, stat.st_size, palm_link, finger_joints, approach_axis, tcp_m, tcp_from_tip_m
+    )
 
 
 @functools.lru_cache(maxsize=8)
-def _load_hand(path, _mtime_ns, _size, palm_link, finger_joints, approach_axis, tcp_m, tcp_from_tip_m) -> HandMeshes:
+def _load_hand(
+    path, _mtime_ns, _size, palm_link, finger_joints, approach_axis, tcp_m, tcp_from_tip_m
+) -> HandMeshes:
     links, joints = _parse(path)
     left, right = _finger_joints(finger_joints, joints, links, path)
     palm = palm_link or left.parent
     palm_group = _rigid_group(palm, joints)
     for j in (left, right):
         if j.parent not in palm_group:
-            raise UrdfError(f"{path} joint {j.name!r} moves from link {j.parent!r}, not from the palm {palm!r}")
+            raise UrdfError(
+                f"{path} joint {j.name!r} moves from link {j.parent!r}, not from the palm {palm!r}"
+            )
     poses = {j.name: palm_group[j.parent] @ j.origin for j in (left, right)}
     y = poses[left.name][:3, :3] @ left.axis
     if float(poses[right.name][:3, :3] @ right.axis @ y) > -0.99:
@@ -293,7 +301,9 @@ def _load_hand(path, _mtime_ns, _size, palm_link, finger_joints, approach_axis, 
     inner_right = max(v[:, 1].max() for v in in_grip[RIGHT])
     gap = inner_left - inner_right
     if tcp_m is None:
-        tcp = np.array([(fingers[:, 0].min() + fingers[:, 0].max()) / 2, 0.0, fingers[:, 2].max() - tcp_from_tip_m])
+        tcp = np.array(
+            [(fingers[:, 0].min() + fingers[:, 0].max()) / 2, 0.0, fingers[:, 2].max() - tcp_from_tip_m]
+        )
     else:
         tcp = np.asarray(tcp_m, dtype=np.float64) @ rot
     tcp[1] = (inner_left + inner_right) / 2
