@@ -50,6 +50,8 @@ class HandMeshes:
     (the real, possibly non-convex shape), in the same frames as ``hulls``: for drawing."""
     max_width_m: float
     """Largest opening between the pads the joints' limits allow, m."""
+    sources: tuple[tuple[Path, int, int], ...]
+    """(path, mtime ns, size) of each mesh file read: a cached hand whose files changed is read again."""
 
     def part_vertices(self, part: int) -> np.ndarray:
         """(V, 3) all hull vertices of one part, its own frame, m."""
@@ -111,8 +113,9 @@ def _mesh_path(filename: str, urdf: Path) -> Path:
     return urdf.parent / rest
 
 
-def _geometry(element: ET.Element, urdf: Path, where: str):
-    """The trimesh.Trimesh of a ``<geometry>`` element, its own frame, metres."""
+def _geometry(element: ET.Element, urdf: Path, where: str, sources: list[Path]):
+    """The trimesh.Trimesh of a ``<geometry>`` element, its own frame, metres; a mesh file read is appended
+    to ``sources``."""
     import trimesh
 
     shape = next(iter(element), None)
@@ -128,7 +131,8 @@ def _geometry(element: ET.Element, urdf: Path, where: str):
         radius = float(_floats(shape.get("radius"), 1, math.nan, where + " radius")[0])
         return trimesh.creation.icosphere(subdivisions=2, radius=radius)
     if shape.tag == "mesh":
-        path = _mesh_path(shape.get("filename", ""), urdf)
+        path = _mesh_path(shape.get("filename", ""), urdf).resolve()
+        sources.append(path)
         if not path.is_file():
             raise UrdfError(f"{where}: mesh file {path} not found")
         try:
@@ -221,7 +225,7 @@ def _collisions_of(link: str, joints: dict[str, _Joint], links: dict[str, ET.Ele
             yield c, pose @ _origin(c.find("origin"), f"link {name!r} collision")
 
 
-def _part_meshes(link: str, pose: np.ndarray, links, joints, urdf: Path) -> list:
+def _part_meshes(link: str, pose: np.ndarray, links, joints, urdf: Path, sources: list[Path]) -> list:
     """trimesh.Trimesh of each collision element of ``link``'s rigid group, in the frame where the link sits
     at ``pose`` (4, 4)."""
     if link not in links:
@@ -231,7 +235,7 @@ def _part_meshes(link: str, pose: np.ndarray, links, joints, urdf: Path) -> list
         element = c.find("geometry")
         if element is None:
             raise UrdfError(f"{urdf} link {link!r}: <collision> without <geometry>")
-        mesh = _geometry(element, urdf, f"{urdf} link {link!r}")
+        mesh = _geometry(element, urdf, f"{urdf} link {link!r}", sources)
         out.append(mesh.apply_transform(pose @ local))
     return out
 
@@ -252,13 +256,31 @@ def load_hand(
     width, ``tcp_from_tip_m`` behind the fingertips). Cached per file state and settings.
     """
     path = Path(urdf).expanduser().resolve()
+    hand = _cached_hand(path, palm_link, finger_joints, approach_axis, tcp_m, tcp_from_tip_m)
+    if hand.sources != _file_states(hand.sources):  # a mesh file changed since: read everything again
+        _load_hand.cache_clear()
+        hand = _cached_hand(path, palm_link, finger_joints, approach_axis, tcp_m, tcp_from_tip_m)
+    return hand
+
+
+def _file_states(files) -> tuple:
+    """((path, mtime_ns, size) of each file of ``files`` ((path, ...) tuples); -1s for a missing one."""
+    out = []
+    for path, *_ in files:
+        try:
+            st = path.stat()
+            out.append((path, st.st_mtime_ns, st.st_size))
+        except OSError:
+            out.append((path, -1, -1))
+    return tuple(out)
+
+
+def _cached_hand(path: Path, *settings) -> HandMeshes:
     try:
         stat = path.stat()
     except OSError:
         raise UrdfError(f"{path} not found") from None
-    return _load_hand(
-        path, stat.st_mtime_ns, stat.st_size, palm_link, finger_joints, approach_axis, tcp_m, tcp_from_tip_m
-    )
+    return _load_hand(path, stat.st_mtime_ns, stat.st_size, *settings)
 
 
 @functools.lru_cache(maxsize=8)
@@ -287,10 +309,11 @@ def _load_hand(
     z = z - (z @ y) * y
     z /= np.linalg.norm(z)
     rot = np.stack([np.cross(y, z), y, z], axis=1)  # columns X, Y, Z of the gripper frame, palm frame
+    sources: list[Path] = []
     parts = {
-        PALM: _part_meshes(palm, np.eye(4), links, joints, path),
-        LEFT: _part_meshes(left.child, poses[left.name], links, joints, path),
-        RIGHT: _part_meshes(right.child, poses[right.name], links, joints, path),
+        PALM: _part_meshes(palm, np.eye(4), links, joints, path, sources),
+        LEFT: _part_meshes(left.child, poses[left.name], links, joints, path, sources),
+        RIGHT: _part_meshes(right.child, poses[right.name], links, joints, path, sources),
     }
     for part, name in ((PALM, palm), (LEFT, left.child), (RIGHT, right.child)):
         if not parts[part]:
@@ -322,4 +345,5 @@ def _load_hand(
     max_width = gap + 2.0 * min(left.upper, right.upper)
     if not max_width > 0:
         raise UrdfError(f"{path}: the finger joints' upper limits give no opening (stroke {max_width:.4g} m)")
-    return HandMeshes(tuple(hulls), tuple(hull_parts), tuple(meshes), float(max_width))
+    states = _file_states(tuple((p,) for p in dict.fromkeys(sources)))
+    return HandMeshes(tuple(hulls), tuple(hull_parts), tuple(meshes), float(max_width), states)
