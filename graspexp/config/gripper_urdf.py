@@ -163,7 +163,7 @@ def _parse(urdf: Path) -> tuple[dict[str, ET.Element], dict[str, _Joint]]:
             raise UrdfError(f"{where} lacks <parent> or <child>")
         axis = _floats(j.find("axis").get("xyz") if j.find("axis") is not None else None, 3, 0.0, where)
         axis = axis if np.any(axis) else np.array([1.0, 0.0, 0.0])
-        upper = float(limit.get("upper", "nan")) if limit is not None else math.nan
+        upper = math.nan if limit is None else float(_floats(limit.get("upper"), 1, math.nan, where)[0])
         joints[name] = _Joint(
             name,
             j.get("type", ""),
@@ -332,13 +332,16 @@ def _load_hand(
     tcp[1] = (inner_left + inner_right) / 2
     shift = {PALM: tcp, LEFT: tcp + [0.0, gap / 2, 0.0], RIGHT: tcp - [0.0, gap / 2, 0.0]}
     hulls, hull_parts, meshes = [], [], []
+    link_names = {PALM: palm, LEFT: left.child, RIGHT: right.child}
     for part, ms in parts.items():
         for m, v in zip(ms, in_grip[part], strict=True):
             local = v - shift[part]
             try:
                 hull = m.convex_hull
             except Exception as exc:  # qhull on a flat or degenerate piece
-                raise UrdfError(f"{path}: a collision piece of part {part} has no 3-D hull: {exc}") from None
+                raise UrdfError(
+                    f"{path} link {link_names[part]!r}: a collision piece has no 3-D hull: {exc}"
+                ) from None
             hulls.append(np.asarray(hull.vertices, dtype=np.float64) @ rot - shift[part])
             hull_parts.append(part)
             meshes.append((part, local, np.asarray(m.faces, dtype=np.int64)))
