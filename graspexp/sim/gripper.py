@@ -6,7 +6,8 @@ pads, +Z approach, +Y closing axis) -> ``finger_left`` (+Y) and ``finger_right``
 force-limited drives coupled by a fixed tendon. A finger joint value q is the distance of that finger's
 inner face from the TCP along +-Y, metres. Rooting the chain at the grasp frame keeps the rotational
 joints near zero during a trial (no gimbal lock): the protocol holds them at 0 and moves the TCP by
-translation offsets (pre-grasp, extend, pull back, lift), as the paper's end effector does.
+translation offsets (pre-grasp, extend, pull back, lift), as the paper's end effector does. A box model's
+palm and fingers carry its boxes; a URDF gripper's carry its convex collision pieces, the rest is the same.
 """
 
 import math

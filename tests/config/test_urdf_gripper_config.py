@@ -8,6 +8,8 @@ from conftest import compose_cfg, write_urdf_gripper
 
 from graspexp.config import ConfigError, validate
 from graspexp.config.compose import compose_validated
+from graspexp.config.gripper import GripperGeometry
+from graspexp.config.gripper_urdf import LEFT
 
 
 def test_the_stroke_comes_from_the_joint_limits(tmp_path):
@@ -57,3 +59,13 @@ def test_finger_joints_must_be_prismatic_and_opposed(tmp_path):
     assert "do not open in opposite directions" in _error("gripper=urdf", f"gripper.urdf={urdf}")
     urdf.write_text(urdf.read_text().replace('type="prismatic"', 'type="revolute"'))
     assert "expected 2 prismatic finger joints" in _error("gripper=urdf", f"gripper.urdf={urdf}")
+
+
+def test_the_tcp_is_behind_the_tips_or_where_the_config_puts_it(tmp_path):
+    urdf = f"gripper.urdf={write_urdf_gripper(tmp_path, curved_tip=False)}"
+    default = GripperGeometry.of(compose_validated(["gripper=urdf", urdf]).gripper)
+    assert (default.root_z_m, default.tip_z_m) == pytest.approx((-0.07, 0.01))  # as the RG2 box model
+    deeper = compose_validated(["gripper=urdf", urdf, "gripper.urdf_tcp_m=[0,0.003,0.065]"]).gripper
+    geometry = GripperGeometry.of(deeper)  # fingers from z = 0 to 0.08 in the palm link: tips 15 mm ahead
+    assert (geometry.root_z_m, geometry.tip_z_m) == pytest.approx((-0.065, 0.015))
+    assert geometry.hand.part_vertices(LEFT)[:, 1].min() == pytest.approx(0.0)  # y ignored: pads centred
