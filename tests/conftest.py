@@ -1,8 +1,10 @@
-"""Shared fixtures: composed configs, the real-mesh data root, an isolated convex-decomposition cache."""
+"""Shared fixtures: composed configs, the real-mesh data root, an isolated convex-decomposition cache, a
+small URDF gripper written at test time."""
 
 import os
 from pathlib import Path
 
+import numpy as np
 import pytest
 from omegaconf import DictConfig
 
@@ -146,3 +148,50 @@ def foreign_log(path: Path, result: dict) -> None:
         channel = w.register_channel("/result", "json", schema)
         w.add_message(channel, 0, json.dumps(result).encode(), 0)
         w.finish()
+
+
+def write_urdf_gripper(
+    folder: Path,
+    *,
+    palm_size_m: tuple[float, float, float] = (0.045, 0.15, 0.06),
+    finger_size_m: tuple[float, float, float] = (0.022, 0.01, 0.08),
+    upper_m: float = 0.055,
+    curved_tip: bool = True,
+) -> Path:
+    """A parallel gripper URDF in ``folder`` shaped like the RG2 box model: a palm box (link ``hand``, its
+    front face at z = 0), two prismatic fingers (``left_joint`` along +y, ``right_joint`` along -y, limits
+    [0, ``upper_m``], pads touching at q = 0) made of a box each, and with ``curved_tip`` a fingertip
+    mesh (``tip.stl``: half a cylinder, written with trimesh) at the top of each finger. Returns the file."""
+    import trimesh
+
+    px, py, pz = palm_size_m
+    fx, ft, fl = finger_size_m
+    tip = ""
+    if curved_tip:  # a half cylinder along x, radius ft/2, flat face down: a rounded fingertip
+        a = np.linspace(0.0, np.pi, 13)
+        arc = np.stack([ft / 2 * np.cos(a), ft / 2 * np.sin(a)], axis=1)
+        pts = np.concatenate([np.insert(arc, 0, x, axis=1) for x in (-fx / 2, fx / 2)])
+        trimesh.convex.convex_hull(pts).export(folder / "tip.stl")
+    links, joints = [], []
+    for name, sign in (("left", 1.0), ("right", -1.0)):
+        if curved_tip:
+            tip = (
+                f'<collision><origin xyz="0 {sign * ft / 2} {fl}"/>'
+                '<geometry><mesh filename="tip.stl"/></geometry></collision>'
+            )
+        links.append(
+            f'<link name="{name}_finger"><collision><origin xyz="0 {sign * ft / 2} {fl / 2}"/>'
+            f'<geometry><box size="{fx} {ft} {fl}"/></geometry></collision>{tip}</link>'
+        )
+        joints.append(
+            f'<joint name="{name}_joint" type="prismatic"><parent link="hand"/><child link="{name}_finger"/>'
+            f'<axis xyz="0 {sign:g} 0"/><limit lower="0" upper="{upper_m}" effort="100" velocity="1"/></joint>'
+        )
+    text = (
+        '<?xml version="1.0"?><robot name="test_gripper"><link name="world_mount"/>'
+        f'<link name="hand"><collision><origin xyz="0 0 {-pz / 2}"/><geometry><box size="{px} {py} {pz}"/>'
+        f"</geometry></collision></link>{''.join(links)}{''.join(joints)}</robot>"
+    )
+    path = folder / "gripper.urdf"
+    path.write_text(text)
+    return path

@@ -1,14 +1,17 @@
 """Schema of the ``gripper`` config group: a parallel-jaw gripper, all lengths in metres.
 
 Gripper frame (paper Fig. 9): +Z approach, +Y closing axis, origin midway between the finger pads.
+A gripper is a box model (finger and palm boxes from the keys below) or, with ``urdf`` set, the collision
+geometry of a URDF (:mod:`graspexp.config.gripper_urdf`); :class:`GripperGeometry` describes both.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from omegaconf import MISSING
 
-from graspexp.config.constraints import TEXT, Interval, Vector
+from graspexp.config.constraints import TEXT, Interval, Names, Vector
+from graspexp.config.gripper_urdf import LEFT, PALM, RIGHT, HandMeshes, load_hand
 
 
 @dataclass
@@ -58,6 +61,22 @@ class GripperConfig:
     """How far past fully closed (q = 0) a finger may travel, m: its joint's lower limit is -this, so the
     limit never takes part of the squeeze on a thin object (with the limit at 0, a 10 mm box got 88 of
     100 N even with the target far past it)."""
+    urdf: str | None = None
+    """URDF file of the hand (a path; ``~`` expanded): its palm and finger collision geometry replaces the
+    finger and palm boxes (``finger_length_m``, ``finger_width_m``, ``finger_thickness_m`` and
+    ``palm_size_m`` are then unused; an unset ``palm_size_m`` is set to the palm's bounding box), and with
+    ``max_width_m`` unset the joints' limits give the stroke. None: the box model of those keys."""
+    urdf_palm_link: str | None = None
+    """URDF link of the palm (with the links fixed to it); None: the finger joints' parent link."""
+    urdf_finger_joints: list[str] | None = None
+    """The two prismatic finger joints [left, right] of the URDF; the left finger opens towards +Y. None:
+    the two prismatic joints with collision geometry below them."""
+    urdf_approach_axis: list[float] = field(default_factory=lambda: [0.0, 0.0, 1.0])
+    """Approach direction (+Z of the gripper frame) in the URDF palm link's frame, unitless (normalised);
+    it must be perpendicular to the finger joints' axes."""
+    urdf_tcp_m: list[float] | None = None
+    """TCP (grasp point) in the URDF palm link's frame, m; its component along the closing axis is set to
+    the pads' middle. None: centred on the fingers' width, ``tcp_from_tip_m`` behind the fingertips."""
     close_force_margin: float = 2.0
     """The finger target lies this many times ``grip_force_n / finger_stiffness_n_per_m`` past closed (at
     least ``close_past_m``), so the drive's spring force at any contact is >= this x ``grip_force_n`` and the
@@ -81,7 +100,9 @@ class GripperGeometry:
 
     Gripper frame: +Z approach, +X main axis, +Y closing axis, origin midway between the pads (the TCP).
     The fingers span ``root_z_m`` (the palm face) to ``tip_z_m`` (the fingertips) along Z; the palm box
-    lies behind the palm face.
+    lies behind the palm face. A URDF gripper carries its convex pieces in ``hand``; its box values are
+    the bounding boxes of its fingers and palm (the pads' reach: ``finger_width_m``, ``root_z_m``,
+    ``tip_z_m``, ``finger_thickness_m``), and every volume check uses ``hand`` instead of the boxes.
     """
 
     finger_width_m: float
@@ -96,10 +117,15 @@ class GripperGeometry:
     """Z of the palm face, where the fingers start, m."""
     tip_z_m: float
     """Z of the fingertips, m (``tcp_from_tip_m`` in front of the TCP)."""
+    hand: HandMeshes | None = None
+    """The convex pieces and meshes of a URDF gripper (None: a box model)."""
 
     @classmethod
     def of(cls, g: GripperConfig) -> "GripperGeometry":
-        """The geometry of gripper config ``g``."""
+        """The geometry of gripper config ``g`` (a URDF's is read once per process, see :func:`hand_of`)."""
+        hand = hand_of(g)
+        if hand is not None:
+            return cls.of_hand(hand)
         return cls(
             g.finger_width_m,
             g.finger_thickness_m,
@@ -107,6 +133,24 @@ class GripperGeometry:
             tuple(float(v) for v in g.palm_size_m),
             g.tcp_from_tip_m - g.finger_length_m,
             g.tcp_from_tip_m,
+        )
+
+    @classmethod
+    def of_hand(cls, hand: HandMeshes) -> "GripperGeometry":
+        """The geometry of a URDF gripper: its pieces, and the bounding boxes of its palm and left finger."""
+        finger = hand.part_vertices(LEFT)
+        palm = hand.part_vertices(PALM)
+        fingers = np.concatenate([finger, hand.part_vertices(RIGHT)])
+        root, tip = float(fingers[:, 2].min()), float(fingers[:, 2].max())
+        x_reach = float(np.abs(fingers[:, 0]).max())
+        return cls(
+            2.0 * x_reach,
+            float(finger[:, 1].max() - finger[:, 1].min()),
+            tip - root,
+            tuple(float(v) for v in palm.max(axis=0) - palm.min(axis=0)),
+            root,
+            tip,
+            hand,
         )
 
     def palm(self) -> Box:
@@ -140,6 +184,23 @@ class GripperGeometry:
         return out
 
 
+def hand_of(g: GripperConfig) -> HandMeshes | None:
+    """The URDF gripper of config ``g`` (None for a box model); raises
+    :class:`graspexp.config.gripper_urdf.UrdfError` for a file that is not a parallel gripper."""
+    if g.urdf is None:
+        return None
+    joints = None if g.urdf_finger_joints is None else tuple(str(n) for n in g.urdf_finger_joints)
+    tcp = None if g.urdf_tcp_m is None else tuple(float(v) for v in g.urdf_tcp_m)
+    return load_hand(
+        str(g.urdf),
+        g.urdf_palm_link,
+        joints,
+        tuple(float(v) for v in g.urdf_approach_axis),
+        tcp,
+        float(g.tcp_from_tip_m),
+    )
+
+
 CONSTRAINTS = {
     "name": TEXT,
     "max_width_m": [Interval(0, 0.5, "right", "m")],
@@ -164,5 +225,10 @@ CONSTRAINTS = {
     "coupling_damping_ns_per_m": [Interval(0, 1e9, unit="N s/m")],
     "close_past_m": [Interval(0, 0.5, unit="m")],
     "close_force_margin": [Interval(1, 100)],
+    "urdf": [None, *TEXT],
+    "urdf_palm_link": [None, *TEXT],
+    "urdf_finger_joints": [None, Names()],
+    "urdf_approach_axis": [Vector(3, Interval(-1, 1))],
+    "urdf_tcp_m": [None, Vector(3, Interval(-1, 1, unit="m"))],
 }
 """Allowed values of every key (see :mod:`graspexp.config.constraints`)."""

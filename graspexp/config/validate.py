@@ -14,6 +14,7 @@ from omegaconf import DictConfig, OmegaConf
 
 from graspexp.config import cost, dataset, gripper, job, mode, rot, sim
 from graspexp.config.constraints import accepts, describe
+from graspexp.config.gripper_urdf import UrdfError
 from graspexp.config.plugins import PluginError, get_plugin
 from graspexp.config.registry import SCHEMAS, group_options
 
@@ -43,6 +44,9 @@ RELATIONS = (
     ("sim.settle_min_s", "<=", "sim.settle_max_s"),
 )
 """Pairs of keys whose values must keep this order."""
+URDF_OPTION = "urdf"
+"""The gripper option that reads ``gripper.urdf`` (conf/gripper/urdf.yaml): without a file it has no
+geometry (a ``???`` in its YAML would not override the schema's None)."""
 
 
 def _fields(schema: type) -> dict[str, dataclasses.Field]:
@@ -88,8 +92,8 @@ def _check_planner(node: DictConfig) -> None:
 
 
 def _missing(dotted: str) -> None:
-    group = dotted.split(".")[0]
-    if group in SCHEMAS or group == "planner":
+    group, _, key = dotted.partition(".")
+    if (group in SCHEMAS or group == "planner") and key in ("", "name"):
         raise ConfigError(
             f"{dotted} has no value: choose an option, {group}= one of {', '.join(group_options(group))}"
         )
@@ -103,7 +107,34 @@ def _check_relations(cfg: DictConfig) -> None:
             raise ConfigError(f"{left}={a!r} is invalid: expected {op} {right}={b!r}")
 
 
+def _check_urdf_gripper(node: DictConfig) -> None:
+    """Read the URDF of a ``gripper.urdf`` (one line naming the file when it is not a parallel gripper) and
+    set an unset ``gripper.max_width_m`` to its stroke (a set one must not exceed it) and an unset
+    ``gripper.palm_size_m`` to the palm's bounding box."""
+    if not isinstance(node, DictConfig) or "urdf" not in node.keys():
+        return
+    if node.urdf is None:
+        if node.get("name") == URDF_OPTION:
+            _missing("gripper.urdf")
+        return
+    try:
+        hand = gripper.hand_of(node)
+    except UrdfError as exc:
+        raise ConfigError(f"gripper.urdf={node.urdf!r} is invalid: {exc}") from None
+    if OmegaConf.is_missing(node, "palm_size_m"):
+        node.palm_size_m = list(gripper.GripperGeometry.of_hand(hand).palm_size_m)
+    if OmegaConf.is_missing(node, "max_width_m"):
+        node.max_width_m = hand.max_width_m
+    elif node.max_width_m > hand.max_width_m + 1e-9:
+        raise ConfigError(
+            f"gripper.max_width_m={node.max_width_m!r} is invalid: expected <= {hand.max_width_m:.6g} m, the "
+            f"stroke of the finger joints of {node.urdf}"
+        )
+
+
 def validate(cfg: DictConfig | Any) -> None:
-    """Raise :class:`ConfigError` naming the first dotted key whose value is unknown, missing or invalid."""
+    """Raise :class:`ConfigError` naming the first dotted key whose value is unknown, missing or invalid.
+    A URDF gripper's file is read here, and its stroke fills an unset ``gripper.max_width_m``."""
+    _check_urdf_gripper(OmegaConf.select(cfg, "gripper", throw_on_missing=False))
     _check_node(cfg, job.JobConfig, "")
     _check_relations(cfg)

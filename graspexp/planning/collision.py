@@ -19,6 +19,9 @@ any cloud point lies inside a swept box grown by ``margin_m`` on every side; poi
 
 Support: the lowest corner of every box, at both ends of the straight approach (the hull of the motion
 is spanned by them), must lie at or above ``table_z + margin_m``.
+
+A URDF gripper (``gripper.urdf``) is checked the same way on its convex pieces instead of the boxes
+(:mod:`.hull_sweep`); the pads' reach (:mod:`.pose`, :mod:`.stability`) uses its fingers' bounding box.
 """
 
 from dataclasses import dataclass
@@ -27,12 +30,13 @@ import numpy as np
 
 from graspexp.config import GripperConfig
 from graspexp.config.gripper import GripperGeometry
+from graspexp.planning.hull_sweep import hull_cloud_hits, hull_lowest_z
 from graspexp.planning.kernels import swept_box_hits
 from graspexp.planning.pose import slab_spans_m
 
 
 def lowest_z(poses: np.ndarray, gripper: GripperConfig, widths_m: np.ndarray, sweep_m: float) -> np.ndarray:
-    """Lowest world z reached by any gripper box during the approach, for a batch of grasps.
+    """Lowest world z reached by any gripper box (or URDF piece) during the approach, for a batch of grasps.
 
     poses : (B, 4, 4) grasp poses, world; widths_m : (B,) openings, m; sweep_m : approach length, m.
     A box swept ``sweep_m`` back along -Z is the box with its z range grown by ``sweep_m`` towards -Z; the
@@ -45,7 +49,10 @@ def lowest_z(poses: np.ndarray, gripper: GripperConfig, widths_m: np.ndarray, sw
     """
     poses = np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4)
     widths = np.broadcast_to(np.asarray(widths_m, dtype=np.float64), (len(poses),))
-    boxes = GripperGeometry.of(gripper).boxes_batch(widths)  # (B, 3, 2, 3)
+    geometry = GripperGeometry.of(gripper)
+    if geometry.hand is not None:
+        return hull_lowest_z(poses, geometry.hand, widths, sweep_m)
+    boxes = geometry.boxes_batch(widths)  # (B, 3, 2, 3)
     boxes[:, :, 0, 2] -= sweep_m
     r = poses[:, 2, :3][:, None, None, :]  # (B, 1, 1, 3): row z of each rotation
     reach = (r * boxes).min(axis=2).sum(axis=-1)  # (B, 3) per box
@@ -61,8 +68,8 @@ def cloud_hits(
     sweep_m: float,
     margin_m: float,
 ) -> np.ndarray:
-    """Number of cloud points inside the swept finger and palm boxes (module doc), per grasp. Compiled
-    (:func:`graspexp.planning.kernels.swept_box_hits`).
+    """Number of cloud points inside the swept finger and palm boxes (or URDF pieces) (module doc), per
+    grasp. Compiled (:func:`graspexp.planning.kernels.swept_box_hits`).
 
     points_m : (N, 3) world; poses : (B, 4, 4) world; widths_m : (B,) or scalar openings, m.
 
@@ -73,6 +80,8 @@ def cloud_hits(
     poses = np.ascontiguousarray(np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4))
     widths = np.broadcast_to(np.asarray(widths_m, dtype=np.float64), (len(poses),))
     geometry = GripperGeometry.of(gripper)
+    if geometry.hand is not None:
+        return hull_cloud_hits(points_m, poses, geometry.hand, widths, sweep_m=sweep_m, margin_m=margin_m)
     fw, t = geometry.finger_width_m, geometry.finger_thickness_m
     px, py, pz = geometry.palm_size_m
     root, tip = geometry.root_z_m, geometry.tip_z_m

@@ -451,3 +451,53 @@ def swept_box_hits(
                 count += 1
         out[b] = count
     return out
+
+
+@_jit
+def swept_hull_hits(
+    points: np.ndarray,
+    poses: np.ndarray,
+    half_widths: np.ndarray,
+    normals: np.ndarray,
+    offsets: np.ndarray,
+    slides: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+) -> np.ndarray:
+    """Points inside any swept convex piece of each grasp (:func:`graspexp.planning.hull_sweep.
+    hull_cloud_hits`). points : (N, 3) world; poses : (B, 4, 4); half_widths : (B,) half openings, m;
+    normals : (P, F, 3) and offsets : (P, F) the pieces' half-spaces ``n . p <= offset`` at zero opening,
+    margin included (padding rows: zero normal, offset 1); slides : (P,) +1, -1 or 0, how half the opening
+    moves a piece along +Y; lo, hi : (P, 3) the pieces' bounding boxes at zero opening, margin included.
+    Returns (B,) int64."""
+    out = np.zeros(poses.shape[0], dtype=np.int64)
+    for b in range(poses.shape[0]):
+        r = poses[b]
+        h = half_widths[b]
+        count = 0
+        for i in range(points.shape[0]):
+            qx, qy, qz = points[i, 0] - r[0, 3], points[i, 1] - r[1, 3], points[i, 2] - r[2, 3]
+            x = r[0, 0] * qx + r[1, 0] * qy + r[2, 0] * qz
+            y = r[0, 1] * qx + r[1, 1] * qy + r[2, 1] * qz
+            z = r[0, 2] * qx + r[1, 2] * qy + r[2, 2] * qz
+            for p in range(normals.shape[0]):
+                yp = y - slides[p] * h
+                if (
+                    x < lo[p, 0]
+                    or x > hi[p, 0]
+                    or yp < lo[p, 1]
+                    or yp > hi[p, 1]
+                    or z < lo[p, 2]
+                    or z > hi[p, 2]
+                ):
+                    continue
+                inside = True
+                for f in range(normals.shape[1]):
+                    if normals[p, f, 0] * x + normals[p, f, 1] * yp + normals[p, f, 2] * z > offsets[p, f]:
+                        inside = False
+                        break
+                if inside:
+                    count += 1
+                    break
+        out[b] = count
+    return out

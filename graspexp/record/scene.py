@@ -24,6 +24,7 @@ from foxglove.messages import (
 
 from graspexp.config import JobConfig
 from graspexp.config.gripper import GripperGeometry
+from graspexp.config.gripper_urdf import LEFT, PALM, RIGHT, HandMeshes
 from graspexp.core.bodies import FINGER_NAMES, OBJECT_NAME, PALM_NAME, SUPPORT_NAME
 from graspexp.sim.collision_shapes import hull_meshes
 
@@ -114,7 +115,7 @@ class ObjectScene:
     static: list[SceneEntity]
     """The support (world frame, id ``support``) and the object's collision hulls (``object`` frame)."""
     gripper: list[SceneEntity]
-    """The palm and finger boxes, each in its own link frame."""
+    """The palm and finger boxes (a URDF gripper: its collision meshes), each in its own link frame."""
 
 
 def object_scene(cfg: JobConfig, hulls: list[np.ndarray]) -> ObjectScene:
@@ -125,9 +126,24 @@ def object_scene(cfg: JobConfig, hulls: list[np.ndarray]) -> ObjectScene:
     for i, m in enumerate(hull_meshes(hulls)):
         static.append(mesh_entity(f"{OBJECT_NAME}_hull_{i}", OBJECT_NAME, m.vertices, m.faces, HULL_COLOR))
     geometry = GripperGeometry.of(cfg.gripper)
+    if geometry.hand is not None:
+        return ObjectScene(static=static, gripper=hand_entities(geometry.hand))
     palm = geometry.palm()
     gripper = [box_entity(PALM_NAME, PALM_NAME, list(palm.center), list(palm.size), GRIPPER_COLOR)]
     for name, sign in zip(FINGER_NAMES, (1.0, -1.0), strict=True):
         finger = geometry.finger(sign)
         gripper.append(box_entity(name, name, list(finger.center), list(finger.size), GRIPPER_COLOR))
     return ObjectScene(static=static, gripper=gripper)
+
+
+def hand_entities(hand: HandMeshes) -> list[SceneEntity]:
+    """One entity per link of a URDF gripper (id and frame ``palm``, ``finger_left``, ``finger_right``): a
+    TriangleListPrimitive of its collision meshes as the URDF gives them, in the link's frame."""
+    out = []
+    for part, name in ((PALM, PALM_NAME), (LEFT, FINGER_NAMES[0]), (RIGHT, FINGER_NAMES[1])):
+        meshes = [(v, f) for p, v, f in hand.meshes if p == part]
+        starts = np.cumsum([0] + [len(v) for v, _ in meshes[:-1]])
+        vertices = np.concatenate([v for v, _ in meshes])
+        faces = np.concatenate([f + s for (_, f), s in zip(meshes, starts, strict=True)])
+        out.append(mesh_entity(name, name, vertices, faces, GRIPPER_COLOR))
+    return out

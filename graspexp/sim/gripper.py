@@ -6,7 +6,8 @@ pads, +Z approach, +Y closing axis) -> ``finger_left`` (+Y) and ``finger_right``
 force-limited drives coupled by a fixed tendon. A finger joint value q is the distance of that finger's
 inner face from the TCP along +-Y, metres. Rooting the chain at the grasp frame keeps the rotational
 joints near zero during a trial (no gimbal lock): the protocol holds them at 0 and moves the TCP by
-translation offsets (pre-grasp, extend, pull back, lift), as the paper's end effector does.
+translation offsets (pre-grasp, extend, pull back, lift), as the paper's end effector does. A box model's
+palm and fingers carry its boxes; a URDF gripper's carry its convex collision pieces, the rest is the same.
 """
 
 import math
@@ -16,6 +17,7 @@ import numpy as np
 import sapien
 
 from graspexp.config.gripper import GripperConfig, GripperGeometry
+from graspexp.config.gripper_urdf import LEFT, PALM, RIGHT, HandMeshes
 from graspexp.core.bodies import FINGER_NAMES, PALM_NAME
 from graspexp.core.geometry import matrix_to_quat_wxyz
 from graspexp.sim.scene import GRIPPER_BIT, OBJECT_BIT, SUPPORT_BIT, set_groups
@@ -72,10 +74,32 @@ class Gripper:
         return self.palm.entity_pose.to_transformation_matrix()
 
 
+def _attach_hulls(
+    entities: list[sapien.Entity], hand: HandMeshes, material: sapien.physx.PhysxMaterial
+) -> None:
+    """Give the palm and finger links (entities not yet in a scene) the convex pieces of a URDF gripper, each
+    in its link's frame (:mod:`graspexp.config.gripper_urdf`)."""
+    links = {e.name: e.find_component_by_type(sapien.physx.PhysxArticulationLinkComponent) for e in entities}
+    names = {PALM: PALM_NAME, LEFT: FINGER_NAMES[0], RIGHT: FINGER_NAMES[1]}
+    one = np.ones(3, dtype=np.float32)
+    for vertices, part in zip(hand.hulls, hand.hull_parts, strict=True):
+        shape = sapien.physx.PhysxCollisionShapeConvexMesh(
+            vertices=np.asarray(vertices, dtype=np.float32), scale=one, material=material
+        )
+        shape.set_density(1000.0)
+        links[names[part]].attach(shape)
+    counts = {name: len(link.collision_shapes) for name, link in links.items() if name in names.values()}
+    expected = {names[p]: hand.hull_parts.count(p) for p in names}
+    if counts != expected:  # PhysX drops a piece whose cooking failed
+        raise RuntimeError(f"URDF gripper pieces attached {counts}, expected {expected}")
+
+
 def build_gripper(
     scene: sapien.Scene, cfg: GripperConfig, grasp_pose: np.ndarray, support_collides: bool
 ) -> Gripper:
-    """Build the gripper with its root at ``grasp_pose`` ((4,4) world); fingers open to the stroke."""
+    """Build the gripper with its root at ``grasp_pose`` ((4,4) world); fingers open to the stroke. A box
+    model gets its finger and palm boxes, a URDF gripper its convex collision pieces; the links, joints,
+    drives and tendon are the same."""
     ab = scene.create_articulation_builder()
     pad = sapien.physx.PhysxMaterial(cfg.pad_friction, cfg.pad_friction, 0.0)
     link = ab.create_link_builder()
@@ -98,9 +122,13 @@ def build_gripper(
     palm = link
     palm.set_name(PALM_NAME)
     geometry = GripperGeometry.of(cfg)
-    box = geometry.palm()
-    palm.add_box_collision(sapien.Pose(list(box.center)), half_size=[s / 2 for s in box.size], material=pad)
-    for name, axis, sign in (("finger_left", "y", 1.0), ("finger_right", "-y", -1.0)):
+    hand = geometry.hand
+    if hand is None:
+        box = geometry.palm()
+        palm.add_box_collision(
+            sapien.Pose(list(box.center)), half_size=[s / 2 for s in box.size], material=pad
+        )
+    for name, axis, sign, part in (("finger_left", "y", 1.0, LEFT), ("finger_right", "-y", -1.0, RIGHT)):
         f = ab.create_link_builder(palm)
         f.set_name(name)
         f.set_joint_name(name)
@@ -108,13 +136,21 @@ def build_gripper(
         f.set_joint_properties(
             "prismatic", [[-cfg.close_past_m, cfg.max_width_m / 2]], sapien.Pose(q=q), sapien.Pose(q=q)
         )
-        box = geometry.finger(sign)
-        center = list(box.center)
-        f.add_box_collision(
-            sapien.Pose(center), half_size=[s / 2 for s in box.size], material=pad, density=1000.0
-        )
+        if hand is None:
+            box = geometry.finger(sign)
+            center = list(box.center)
+            f.add_box_collision(
+                sapien.Pose(center), half_size=[s / 2 for s in box.size], material=pad, density=1000.0
+            )
+        else:
+            center = hand.part_vertices(part).mean(axis=0).tolist()
         f.set_mass_and_inertia(cfg.finger_mass_kg, sapien.Pose(center), [1e-5] * 3)
-    art = ab.build(fix_root_link=True)
+    entities = ab.build_entities(fix_root_link=True)
+    if hand is not None:
+        _attach_hulls(entities, hand, pad)
+    for entity in entities:
+        scene.add_entity(entity)
+    art = entities[0].find_component_by_type(sapien.physx.PhysxArticulationLinkComponent).articulation
     art.name = "gripper"
     art.set_root_pose(sapien.Pose(grasp_pose[:3, 3], matrix_to_quat_wxyz(grasp_pose[:3, :3])))
     mask = OBJECT_BIT | (SUPPORT_BIT if support_collides else 0)

@@ -6,7 +6,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import compose_cfg
+from conftest import compose_cfg, write_urdf_gripper
 from omegaconf import OmegaConf
 
 from graspexp.config import AntipodalConfig, ConfigError, JobConfig, OptimalConfig, sim, validate
@@ -25,8 +25,9 @@ GROUPS = {
 
 
 @pytest.mark.parametrize(("group", "option"), [(g, o) for g, opts in GROUPS.items() for o in opts])
-def test_every_option_of_every_group_composes_and_validates(group, option):
-    cfg = compose_cfg(f"{group}={option}")
+def test_every_option_of_every_group_composes_and_validates(group, option, tmp_path):
+    extra = [f"gripper.urdf={write_urdf_gripper(tmp_path)}"] if (group, option) == ("gripper", "urdf") else []
+    cfg = compose_cfg(f"{group}={option}", *extra)
     validate(cfg)
     if group not in ("cost", "sim"):  # single-option groups without a name field
         assert cfg[group].name == option
@@ -34,7 +35,7 @@ def test_every_option_of_every_group_composes_and_validates(group, option):
 
 def test_groups_are_the_documented_ones():
     assert {"dataset", "mode", "rot", "gripper", "planner", "cost", "sim"} <= set(GROUPS)
-    assert GROUPS["gripper"] == ["panda", "rg2", "robotiq_2f85"]
+    assert GROUPS["gripper"] == ["panda", "rg2", "robotiq_2f85", "urdf"]
     assert {"optimal", "optimal_plus", "antipodal", "obb", "random"} <= set(GROUPS["planner"])
 
 

@@ -1,12 +1,16 @@
 """The grip force is what the config says: every gripper option, closed on a thin and on a wide box, presses
 each finger with grip_force_n within 5 % once the fingers have stopped (real SAPIEN physics)."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import sapien
-from conftest import compose_cfg
+from conftest import compose_cfg, write_urdf_gripper
 from omegaconf import OmegaConf
 
+from graspexp.config import validate
+from graspexp.config.compose import compose_validated
 from graspexp.config.registry import group_options
 from graspexp.core.bodies import OBJECT_NAME
 from graspexp.sim.contacts import finger_forces
@@ -22,9 +26,18 @@ MEASURE_S = 0.1
 """The force is averaged over the last 0.1 s of sim.close_s, s."""
 
 
-def steady_finger_forces(gripper: str, width_m: float) -> tuple[np.ndarray, float]:
-    """((2,) mean force of each finger on a static box of ``width_m`` along the closing axis, N; grip_force_n)."""
-    cfg = OmegaConf.to_object(compose_cfg(f"gripper={gripper}"))
+def gripper_overrides(gripper: str, folder: Path) -> list[str]:
+    """Overrides that choose gripper option ``gripper``; ``urdf`` gets the test URDF written into ``folder``."""
+    extra = [f"gripper.urdf={write_urdf_gripper(folder)}"] if gripper == "urdf" else []
+    return [f"gripper={gripper}", *extra]
+
+
+def steady_finger_forces(overrides: list[str], width_m: float) -> tuple[np.ndarray, float]:
+    """((2,) mean force of each finger on a static box of ``width_m`` along the closing axis, N; grip_force_n)
+    for the gripper of ``overrides``."""
+    composed = compose_cfg(*overrides)
+    validate(composed)
+    cfg = OmegaConf.to_object(composed)
     configure_physx(cfg.sim)
     scene = sapien.Scene([sapien.physx.PhysxCpuSystem()])
     scene.set_timestep(cfg.sim.timestep_s)
@@ -45,7 +58,8 @@ def steady_finger_forces(gripper: str, width_m: float) -> tuple[np.ndarray, floa
 
 @pytest.mark.parametrize("gripper", group_options("gripper"))
 @pytest.mark.parametrize("wide", [False, True], ids=["thin", "wide"])
-def test_steady_finger_force_is_the_configured_grip_force(gripper: str, wide: bool) -> None:
-    stroke = compose_cfg(f"gripper={gripper}").gripper.max_width_m
-    forces, grip_force = steady_finger_forces(gripper, WIDE_FRACTION * stroke if wide else THIN_M)
+def test_steady_finger_force_is_the_configured_grip_force(gripper: str, wide: bool, tmp_path: Path) -> None:
+    overrides = gripper_overrides(gripper, tmp_path)
+    stroke = compose_validated(overrides).gripper.max_width_m
+    forces, grip_force = steady_finger_forces(overrides, WIDE_FRACTION * stroke if wide else THIN_M)
     np.testing.assert_allclose(forces, grip_force, rtol=0.05)
