@@ -60,6 +60,9 @@ class TrialResult:
     execute spent inside the physics step itself."""
     sim_time_s: float = 0.0
     steps: int = 0
+    at_rest: bool = True
+    """False when the settle time cap (``sim.settle_max_s``) ran out before the object came to rest: the
+    planner saw a moving object (the log's ``settle_timeout`` phase says how fast it still moved)."""
 
     def to_dict(self) -> dict:
         return asdict(self)

@@ -56,6 +56,7 @@ TOPIC_SCHEMAS: dict[str, str] = {
 PHASE_NAMES = (
     "drop",
     "settled",
+    "settle_timeout",
     "plan",
     "pre_grasp",
     "approach",

@@ -26,8 +26,12 @@ from hydra.experimental.callback import Callback
 from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf
 
+from graspexp.run.locks import DirectoryLock, RunError
+
 SWEEP_ID_ENV = "GRASPEXP_SWEEP_ID"
 """Environment variable naming the running multirun (set by :class:`SweepReport`, inherited by jobs)."""
+SWEEP_LOCK_NAME = ".graspexp-sweep.lock"
+"""Lock file of a sweep directory, held by the process that launches the sweep's jobs."""
 FAILED_DIR = ".graspexp-failed"
 """Folder under the sweep directory holding one record per failed job, per sweep id."""
 MAX_VALUE_CHARS = 32
@@ -122,10 +126,18 @@ class SweepReport(Callback):
 
     def on_multirun_start(self, config: DictConfig, **kwargs: Any) -> None:
         self._check_output(config.hydra.sweep.dir)
+        self._lock = DirectoryLock(Path(config.hydra.sweep.dir), SWEEP_LOCK_NAME, "sweep")
+        try:  # the sweep owns its directory: a second sweep into it is refused before any job runs
+            self._lock.acquire()
+        except RunError as exc:
+            print(f"graspexp: error: {exc}", file=sys.stderr)
+            raise SystemExit(2) from None
         os.environ[SWEEP_ID_ENV] = uuid.uuid4().hex
         self._started = time.perf_counter()
 
     def on_multirun_end(self, config: DictConfig, **kwargs: Any) -> None:
+        if getattr(self, "_lock", None) is not None:
+            self._lock.release()
         wall = time.perf_counter() - getattr(self, "_started", time.perf_counter())
         print(f"\ngraspexp: sweep {config.hydra.sweep.dir} done in {wall:.1f} s wall", file=sys.stderr)
         folder = Path(config.hydra.sweep.dir) / FAILED_DIR / os.environ.get(SWEEP_ID_ENV, "unknown")

@@ -20,17 +20,12 @@ import hashlib
 import logging
 import os
 import platform
-import socket
-import sys
 import time
 import traceback
-from collections.abc import Iterator
-from contextlib import contextmanager
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 import pandas as pd
-from filelock import FileLock, Timeout
 from omegaconf import DictConfig, OmegaConf
 from threadpoolctl import threadpool_limits
 from tqdm import tqdm
@@ -54,6 +49,7 @@ from graspexp.record import (
 from graspexp.record.reader import read_metadata
 from graspexp.record.scene import ObjectScene, object_scene
 from graspexp.record.writer import is_write_error
+from graspexp.run.locks import DirectoryLock, RunError
 from graspexp.run.prepare import prepare_shapes
 from graspexp.sim.collision_shapes import ShapeError, shape_with_fallback
 from graspexp.sim.shape import CollisionShape
@@ -82,11 +78,6 @@ def package_versions() -> dict[str, str]:
 
 NO_SPACE_ERRNOS = (errno.ENOSPC, errno.EFBIG, errno.EDQUOT)
 """Write errors that mean no room is left (a full disk or quota, a file-size limit)."""
-
-
-class RunError(RuntimeError):
-    """A job that cannot run as asked: a missing or unreadable input, an unwritable output folder, a
-    directory held by another run or holding logs of another config. The message is one line."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -352,32 +343,10 @@ def check_resumable(cfg: DictConfig, run_dir: Path) -> None:
         quarantine(path, run_dir, why)
 
 
-@contextmanager
-def job_lock(run_dir: Path) -> Iterator[None]:
-    """Hold the exclusive lock of ``run_dir`` for the block; RunError naming the holder if another run has it."""
-    holder = run_dir / HOLDER_NAME
-    lock = FileLock(run_dir / LOCK_NAME, timeout=0)
-    try:
-        run_dir.mkdir(parents=True, exist_ok=True)
-        lock.acquire()
-    except Timeout:
-        try:
-            who = holder.read_text().strip()
-        except OSError:
-            who = "unknown"
-        raise RunError(
-            f"{run_dir} is in use by another run ({who}); wait for it to finish or use another "
-            "output directory (hydra.run.dir / hydra.sweep.dir)"
-        ) from None
-    except OSError as exc:
-        raise RunError(f"cannot write to the output directory {run_dir}: {exc.strerror or exc}") from None
-    try:
-        now = datetime.datetime.now().astimezone().isoformat(timespec="seconds")
-        cmd = " ".join(sys.argv)
-        holder.write_text(f"pid {os.getpid()} on {socket.gethostname()} since {now}: {cmd}\n")
-        yield
-    finally:
-        lock.release()
+def job_lock(run_dir: Path) -> DirectoryLock:
+    """The exclusive lock of job directory ``run_dir`` (a context manager); RunError naming the holder if
+    another run has it."""
+    return DirectoryLock(run_dir, LOCK_NAME, "run")
 
 
 def summarize(df: pd.DataFrame) -> pd.DataFrame:

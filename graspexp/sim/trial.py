@@ -253,9 +253,9 @@ class _Sim:
         self.timings["log"] += time.perf_counter() - t0
 
 
-def _settle(sim: _Sim) -> bool:
+def _settle(sim: _Sim) -> tuple[bool, bool]:
     """Step until the object rests (below both settle speeds for ``settle_hold_s``), falls below the
-    support, or the time cap; True if it is on the support."""
+    support, or the time cap ``settle_max_s``; (on the support, at rest: False when the cap ran out first)."""
     cfg = sim.cfg.sim
     body = sim.ts.object_body
     min_steps = int(cfg.settle_min_s / sim.dt)
@@ -266,11 +266,11 @@ def _settle(sim: _Sim) -> bool:
     for _ in range(int(cfg.settle_max_s / sim.dt)):
         sim.step()
         if body.get_entity_pose().p[2] < below_z:
-            return False
+            return False, False
         still = still + 1 if sim.speed_sq[0] < linear_sq and sim.speed_sq[1] < angular_sq else 0
         if sim.steps >= min_steps and still >= hold_steps:
-            break
-    return _on_support(sim.ts, sim.cfg)
+            return _on_support(sim.ts, sim.cfg), True
+    return _on_support(sim.ts, sim.cfg), False
 
 
 def _on_support(ts: TrialScene, cfg: JobConfig) -> bool:
@@ -280,6 +280,18 @@ def _on_support(ts: TrialScene, cfg: JobConfig) -> bool:
     hx, hy = cfg.mode.support_half_size_m
     tolerance = cfg.sim.on_support_tolerance_m
     return bool(lo[2] > ts.table_z - tolerance and abs(com[0]) <= hx and abs(com[1]) <= hy)
+
+
+def _check_gripper_stable(sim: _Sim, gripper: Gripper) -> None:
+    """Raise SIM_UNSTABLE when a gripper link's pose is not finite or it moves faster than
+    ``sim.max_speed_mps``: a failure to hold that the physics, not the grasp, caused (an extreme setting)."""
+    for link in (gripper.palm, *gripper.fingers):
+        pose, v = link.entity_pose, np.asarray(link.get_linear_velocity(), dtype=float)
+        if not (np.all(np.isfinite(pose.p)) and np.all(np.isfinite(pose.q)) and v.dot(v) <= sim.max_speed_sq):
+            raise TrialFailed(
+                FailureReason.SIM_UNSTABLE,
+                f"gripper link {link.name} at {np.round(pose.p, 3).tolist()} m, speed {float(v.dot(v)) ** 0.5:.3g} m/s",
+            )
 
 
 def _grasp_record(grasp: Grasp) -> dict:
@@ -348,9 +360,20 @@ def _drop_until_on_support(ctx: TrialContext, res: TrialResult, timings: dict) -
             ctx.recorder.scene(0.0, ctx.scene.static)
         sim.phase("drop", {"attempt": attempt})
         with sim.timed("settle"):
-            on_support = _settle(sim)
+            on_support, at_rest = _settle(sim)
         if on_support:
-            sim.phase("settled", {"redrops": attempt})
+            res.at_rest = at_rest
+            if at_rest:
+                sim.phase("settled", {"redrops": attempt})
+            else:  # planned on a moving object: said, not hidden
+                speed, spin = (float(v) ** 0.5 for v in sim.speed_sq)
+                info = {
+                    "redrops": attempt,
+                    "speed_mps": speed,
+                    "angular_radps": spin,
+                    "cap_s": cfg.sim.settle_max_s,
+                }
+                sim.phase("settle_timeout", info)
             return sim
         res.redrops = attempt + 1
         log_offset_s = sim.log_t + sim.dt
@@ -434,6 +457,7 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
     forces = _held(sim, grasp)
     if min(forces.values()) < ctx.cfg.sim.min_finger_force_n:
         res.finger_force_n = [forces[n] for n in FINGER_NAMES]
+        _check_gripper_stable(sim, gripper)
         raise TrialFailed(FailureReason.NO_CONTACT, f"finger forces after closing {forces} N")
 
     grip0 = _grasp_point_on_object(gripper, ts)
@@ -459,6 +483,7 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
     res.slip_m = float(np.linalg.norm(_grasp_point_on_object(gripper, ts) - grip0))
     n_touching = sum(f >= ctx.cfg.sim.min_finger_force_n for f in forces.values())
     if n_touching < len(forces):  # paper IV-C: success = the object is still held by the gripper
+        _check_gripper_stable(sim, gripper)
         raise TrialFailed(
             FailureReason.DROPPED,
             f"{n_touching} of {len(forces)} fingers press on the object after the hold "

@@ -168,3 +168,20 @@ def test_job_dir_name_is_readable_short_and_unique() -> None:
     assert other != name and len(other) == len(name)
     many = [f"k{i}=v{i}" for i in range(60)]
     assert len(job_dir_name(many, [])) == 120 and "/" not in job_dir_name(["dataset.root=/a/b"], [])
+
+
+@pytest.mark.slow
+def test_a_second_sweep_into_a_running_sweeps_directory_is_refused_before_any_job(tmp_path: Path) -> None:
+    from graspexp.run.jobs import SWEEP_LOCK_NAME
+    from graspexp.run.locks import DirectoryLock
+
+    sweep = tmp_path / "sweep"
+    with DirectoryLock(sweep, SWEEP_LOCK_NAME, "sweep"):  # the first sweep, still launching its jobs
+        proc = subprocess.run(_cmd(sweep), cwd=REPO, env=_env(), capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2, proc.stderr[-2000:]
+    lines = [ln for ln in proc.stderr.splitlines() if ln.startswith("graspexp: error:")]
+    assert len(lines) == 1 and f"{sweep} is in use by another sweep (pid {os.getpid()} on " in lines[0]
+    assert "Traceback" not in proc.stderr
+    assert not [p for p in sweep.iterdir() if not p.name.startswith(SWEEP_LOCK_NAME)]  # no job started
+    _run(_cmd(sweep))  # once it is free, the sweep runs
+    assert not (sweep / f"{SWEEP_LOCK_NAME}.holder").exists()

@@ -194,3 +194,12 @@ def test_the_fingers_close_only_once_the_arm_has_reached_the_grasp_pose(settle_s
     palm = make_pose(quat_wxyz_to_matrix(np.asarray(q)), np.asarray(p))
     short_m = float(np.linalg.norm((np.linalg.inv(rec.pose) @ palm)[:3, 3]))
     assert (short_m < 5e-4) if reached else (short_m > 3e-3), short_m
+
+
+def test_a_settle_cap_that_runs_out_is_said_not_logged_as_settled():
+    capture = ContactCapture()
+    res = run_trial(_ctx("sim.settle_min_s=0.01", "sim.settle_max_s=0.02", recorder=capture))
+    assert res.at_rest is False and "settle_timeout" in capture.phases and "settled" not in capture.phases
+    capture = ContactCapture()
+    res = run_trial(_ctx(recorder=capture))
+    assert res.at_rest is True and "settled" in capture.phases and "settle_timeout" not in capture.phases

@@ -5,7 +5,8 @@ Every ``results.csv`` under BEFORE is matched with the file at the same relative
 ``--planner OLD=NEW``: a preset renamed between the runs, ``planner=OLD`` in the path and ``OLD`` in the
 ``planner`` column stand for ``NEW``), and
 every row (keyed by object and trial) is compared cell by cell as text, so a float that changed in its last
-digit counts. Wall-clock timing columns (``timings_s*``) are ignored. Exit status 0 when every row is
+digit counts. Wall-clock timing columns (``timings_s*``) are ignored, and so is a column only one side has (a
+result field added between the runs; named in the output). Exit status 0 when every row is
 identical, 1 otherwise (the differing cells are printed).
 """
 
@@ -30,9 +31,12 @@ def _rows(path: Path) -> dict[tuple[str, str], dict[str, str]]:
         }
 
 
-def compare(before: Path, after: Path, rename: tuple[str, str] | None = None) -> list[str]:
+def compare(
+    before: Path, after: Path, rename: tuple[str, str] | None = None, one_sided: set[str] | None = None
+) -> list[str]:
     """Differences between the sweeps under ``before`` and ``after``, one line each; [] when identical.
-    ``rename``: (old, new) planner name (module doc)."""
+    ``rename``: (old, new) planner name (module doc). A column only one side has (a result field added
+    between the runs) is not compared; its name goes into ``one_sided`` when given."""
     problems = []
     tables = sorted(p.relative_to(before) for p in before.rglob("results.csv"))
     if not tables:
@@ -53,8 +57,10 @@ def compare(before: Path, after: Path, rename: tuple[str, str] | None = None) ->
             if key not in a or key not in b:
                 problems.append(f"{rel} {key}: only under {before if key in a else after}")
                 continue
-            for col in sorted(a[key].keys() | b[key].keys()):
-                if a[key].get(col) != b[key].get(col):
+            if one_sided is not None:
+                one_sided |= a[key].keys() ^ b[key].keys()
+            for col in sorted(a[key].keys() & b[key].keys()):
+                if a[key][col] != b[key][col]:
                     problems.append(f"{rel} {key} {col}: {a[key].get(col)!r} != {b[key].get(col)!r}")
     return problems
 
@@ -73,11 +79,14 @@ def main(argv: list[str] | None = None) -> int:
         if not sep or not old or not new:
             parser.error(f"--planner {args.planner!r}: expected OLD=NEW, e.g. optimal=optimal_in_area")
         rename = (old, new)
-    problems = compare(args.before, args.after, rename)
+    one_sided: set[str] = set()
+    problems = compare(args.before, args.after, rename, one_sided)
     n_tables = len(list(args.before.rglob("results.csv")))
     n_rows = sum(len(_rows(p)) for p in args.before.rglob("results.csv"))
     for line in problems:
         print(line)
+    if one_sided:
+        print(f"not compared (a column of one side only): {', '.join(sorted(one_sided))}")
     print(
         f"{n_tables} results.csv, {n_rows} trials: {'identical' if not problems else f'{len(problems)} differences'}"
     )
