@@ -111,6 +111,10 @@ def writable_dir_problem(path: Path) -> str | None:
     return None
 
 
+_SWEEP_LOCKS: dict[str, DirectoryLock] = {}
+"""The sweep locks this process holds, by sweep directory (not on the callback: joblib pickles it)."""
+
+
 class SweepReport(Callback):
     """Hydra callback (``hydra.callbacks`` in ``conf/config.yaml``): checks the output folder before Hydra
     writes into it, and ends a multirun with the summary of the jobs that could not run."""
@@ -126,9 +130,10 @@ class SweepReport(Callback):
 
     def on_multirun_start(self, config: DictConfig, **kwargs: Any) -> None:
         self._check_output(config.hydra.sweep.dir)
-        self._lock = DirectoryLock(Path(config.hydra.sweep.dir), SWEEP_LOCK_NAME, "sweep")
+        lock = DirectoryLock(Path(config.hydra.sweep.dir), SWEEP_LOCK_NAME, "sweep")
         try:  # the sweep owns its directory: a second sweep into it is refused before any job runs
-            self._lock.acquire()
+            lock.acquire()
+            _SWEEP_LOCKS[str(config.hydra.sweep.dir)] = lock
         except RunError as exc:
             print(f"graspexp: error: {exc}", file=sys.stderr)
             raise SystemExit(2) from None
@@ -136,8 +141,9 @@ class SweepReport(Callback):
         self._started = time.perf_counter()
 
     def on_multirun_end(self, config: DictConfig, **kwargs: Any) -> None:
-        if getattr(self, "_lock", None) is not None:
-            self._lock.release()
+        lock = _SWEEP_LOCKS.pop(str(config.hydra.sweep.dir), None)
+        if lock is not None:
+            lock.release()
         wall = time.perf_counter() - getattr(self, "_started", time.perf_counter())
         print(f"\ngraspexp: sweep {config.hydra.sweep.dir} done in {wall:.1f} s wall", file=sys.stderr)
         folder = Path(config.hydra.sweep.dir) / FAILED_DIR / os.environ.get(SWEEP_ID_ENV, "unknown")

@@ -15,7 +15,7 @@ from tqdm import tqdm
 from graspexp.config import SimConfig
 from graspexp.datasets import DatasetError, available_objects, catalogue
 from graspexp.datasets.loader import object_mesh
-from graspexp.sim.collision_shapes import is_cached, shape_with_fallback
+from graspexp.sim.collision_shapes import ShapeError, is_cached, shape_with_fallback
 
 log = logging.getLogger(__name__)
 REFRESH_S = 5.0
@@ -31,16 +31,17 @@ def _build_one(dataset: dict, sim: SimConfig | DictConfig, name: str) -> tuple[s
 
 def prepare_shapes(
     dataset_cfg: DictConfig, sim: SimConfig | DictConfig, names: list[str], progress: bool = True
-) -> None:
+) -> dict[str, str]:
     """Build the missing collision shapes of objects ``names`` of ``dataset_cfg`` into the cache.
 
     Objects whose shape is cached are skipped; the rest are built by ``sim.prepare_workers`` processes,
-    one object each, with a progress bar that names the objects in work. An object whose mesh cannot be
-    loaded or whose shape cannot be built is logged and left to its trials, which record the error.
+    one object each, with a progress bar that names the objects in work. Returns ``{name: why}`` for the
+    objects whose mesh cannot be loaded or whose shape cannot be built (their trials record it).
     """
-    missing = [n for n in names if _needs_build(dataset_cfg, sim, n)]
+    failed: dict[str, str] = {}
+    missing = [n for n in names if _needs_build(dataset_cfg, sim, n, failed)]
     if not missing:
-        return
+        return failed
     dataset = OmegaConf.to_container(dataset_cfg, resolve=True)
     workers = max(1, min(int(sim.prepare_workers), len(missing))) if _can_spawn() else 1
     desc = f"collision shapes ({sim.collision_method}, {dataset_cfg.name})"
@@ -48,8 +49,12 @@ def prepare_shapes(
         if workers == 1:
             for name in missing:
                 bar.set_postfix_str(f"building {name}")
-                _report(bar, _build_one(dataset, sim, name))
-            return
+                try:
+                    _report(bar, _build_one(dataset, sim, name))
+                except (DatasetError, ShapeError) as exc:
+                    failed[name] = str(exc)
+                    bar.update()
+            return failed
         ctx = multiprocessing.get_context("spawn")  # no fork of a process that holds PhysX threads
         with ProcessPoolExecutor(workers, mp_context=ctx) as pool:
             running = {pool.submit(_build_one, dataset, sim, n): n for n in missing}
@@ -61,10 +66,12 @@ def prepare_shapes(
                     name = running.pop(fut)
                     if fut.exception() is not None:
                         log.error("collision shape of %s failed: %s", name, fut.exception())
+                        failed[name] = str(fut.exception())
                         bar.update()
                     else:
                         _report(bar, fut.result())
                 bar.refresh()
+    return failed
 
 
 def _can_spawn() -> bool:
@@ -75,11 +82,14 @@ def _can_spawn() -> bool:
     return multiprocessing.get_start_method(allow_none=True) in (None, "fork", "spawn", "forkserver")
 
 
-def _needs_build(dataset_cfg: DictConfig, sim: SimConfig | DictConfig, name: str) -> bool:
+def _needs_build(
+    dataset_cfg: DictConfig, sim: SimConfig | DictConfig, name: str, failed: dict[str, str]
+) -> bool:
     try:
         return not is_cached(object_mesh(dataset_cfg, name)[0].mesh, sim)
-    except DatasetError:
-        return False  # the object's trials report the missing or broken mesh
+    except DatasetError as exc:
+        failed[name] = str(exc)  # the object's trials report the missing or broken mesh
+        return False
 
 
 def _report(bar: tqdm, result: tuple[str, float, float, int]) -> None:

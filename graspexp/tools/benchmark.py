@@ -57,7 +57,7 @@ from graspexp.report.render import display_frame, footnotes, markdown
 from graspexp.report.stats import percentiles, success_pct
 from graspexp.report.tables import failure_breakdown, success_table
 from graspexp.run.suites import NOISE_LEVELS, PAPER_MODES, PAPER_ROTS, Job, benchmark_suite
-from graspexp.tools.cli import compose_checked, fail, tool_parser
+from graspexp.tools.cli import compose_checked, fail, positive_int, tool_parser
 
 TRIAL_COLUMNS = (
     "planner",
@@ -132,7 +132,9 @@ def arg_parser() -> argparse.ArgumentParser:
         "--compare", type=_names, help="planners ranked beside it (default: the built-in ones)"
     )
     parser.add_argument("--out", default=Benchmark.out, help=f"output folder (default {Benchmark.out})")
-    parser.add_argument("--n-jobs", type=int, default=Benchmark.n_jobs, help="jobs in parallel (joblib)")
+    parser.add_argument(
+        "--n-jobs", type=positive_int, default=Benchmark.n_jobs, help="jobs in parallel (joblib)"
+    )
     parser.add_argument("--launcher", choices=("joblib", "submitit"), default=Benchmark.launcher)
     parser.add_argument("--slurm-partition", default=Benchmark.slurm_partition, help="with submitit")
     parser.add_argument("--timeout-min", type=int, default=Benchmark.timeout_min, help="with submitit")

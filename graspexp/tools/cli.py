@@ -46,6 +46,17 @@ def fail(message: str, prog: str = "graspexp") -> None:
     raise SystemExit(2)
 
 
+def positive_int(text: str) -> int:
+    """An argparse type: an integer >= 1 (``--n-jobs 0`` is refused at once, not after the work)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {value}")
+    return value
+
+
 def tool_parser(prog: str, description: str, overrides: bool = False) -> argparse.ArgumentParser:
     """The argument parser every tool starts from: ``prog`` (``graspexp.<tool>``) in its usage and errors;
     with ``overrides`` it takes any number of ``key=value`` Hydra overrides (``args.overrides``), anywhere

@@ -36,6 +36,7 @@ import signal
 import sys
 import tarfile
 import threading
+import urllib.parse
 import zipfile
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
@@ -66,9 +67,23 @@ _LINEMOD_FOLDERS = ("models", "models_eval")
 log = logging.getLogger(__name__)
 
 
+LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "::1")
+"""Hosts a plain ``http://`` base URL may name (a local mirror); any other host must be ``https://``."""
+
+
 def base_url(dataset: str, override: str | None = None) -> str:
-    """The base URL for ``dataset``: ``override``, else its env variable, else the official host."""
+    """The base URL for ``dataset``: ``override``, else its env variable, else the official host. A YCB
+    archive's hash is recorded on its first download (the set publishes none), so the first download must
+    come over HTTPS (or from this machine): a plain-http URL of another host is refused."""
     url = override or os.environ.get(URL_ENV[dataset]) or DEFAULT_URL[dataset]
+    parsed = urllib.parse.urlparse(url)
+    if parsed.scheme not in ("https", "http", "file") or (
+        parsed.scheme == "http" and parsed.hostname not in LOOPBACK_HOSTS
+    ):
+        raise DatasetError(
+            f"base URL {url!r} is not https: archives whose hash is recorded on first download must come "
+            "over https (or from localhost); give an https:// mirror"
+        )
     return url if url.endswith("/") else url + "/"
 
 
@@ -195,13 +210,19 @@ def _safe_parts(name: str, archive: Path) -> tuple[str, ...]:
     return parts
 
 
-def _untar(archive: Path, dest: Path) -> None:
-    """Unpack a .tgz into ``dest``: regular files and folders only, no path leaving ``dest``."""
+def _untar(archive: Path, dest: Path, only: str) -> None:
+    """Unpack a .tgz into ``dest``: regular files and folders only, each inside ``dest/only`` (one object's
+    archive never writes over another object's verified files)."""
     try:
         with tarfile.open(archive, "r:*") as tar:
             members = []
             for member in tar.getmembers():
-                _safe_parts(member.name, archive)
+                parts = _safe_parts(member.name, archive)
+                if parts and parts[0] != only:
+                    raise DatasetError(
+                        f"archive {archive} holds {member.name}, outside {only}/: an archive only unpacks its "
+                        "own object; delete it and download again"
+                    )
                 if member.isfile() or member.isdir():
                     members.append(member)
             kwargs = {"filter": "data"} if hasattr(tarfile, "data_filter") else {}
@@ -244,7 +265,7 @@ def download_ycb(
             registry[key] = {"sha256": digest, "url": source}
             _write_registry(root, registry)
             print(f"recorded SHA-256 {digest} of {fname} in {root / HASH_REGISTRY}")
-        _untar(archive, dest)
+        _untar(archive, dest, name)
         mesh = dest / name / "google_16k" / "textured.obj"
         if not mesh.is_file():
             raise DatasetError(f"archive {archive} did not contain {name}/google_16k/textured.obj")

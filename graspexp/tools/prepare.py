@@ -10,6 +10,7 @@ Usage::
 """
 
 import logging
+import sys
 import time
 from collections.abc import Sequence
 
@@ -20,7 +21,8 @@ from graspexp.run.prepare import prepare_shapes, staged_objects
 from graspexp.tools.cli import compose_checked, fail, tool_parser
 
 
-def main(argv: Sequence[str] | None = None) -> None:
+def main(argv: Sequence[str] | None = None) -> int:
+    """Exit status 0, 1 when some objects could not be prepared (each named on stderr), 2 for bad input."""
     prog = "graspexp prepare"
     parser = tool_parser(prog, __doc__.splitlines()[0], overrides=True)
     parser.add_argument("--all", action="store_true", help="every catalogue object with a mesh on disk")
@@ -31,11 +33,15 @@ def main(argv: Sequence[str] | None = None) -> None:
         names = staged_objects(cfg.dataset) if args.all else select_objects(cfg.dataset, cfg.objects)
         sim = OmegaConf.to_object(cfg.sim)
         t0 = time.perf_counter()
-        prepare_shapes(cfg.dataset, sim, names)
+        failed = prepare_shapes(cfg.dataset, sim, names)
     except DatasetError as err:
         fail(str(err), prog)
-    print(f"{len(names)} collision shapes of {cfg.dataset.name} ready in {time.perf_counter() - t0:.1f} s")
+    ready = len(names) - len(failed)
+    print(f"{ready} collision shapes of {cfg.dataset.name} ready in {time.perf_counter() - t0:.1f} s")
+    for name, why in failed.items():
+        print(f"{prog}: {name}: NOT prepared: {why}", file=sys.stderr)
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

@@ -296,3 +296,34 @@ def test_interrupted_download_leaves_no_temporary_file(server, tmp_path, sig):
         ycb_archive(folder)
         download.download_ycb(root, [YCB_ID], url=url, progress=False)
     assert not list(archives.glob("tmp*"))
+
+
+def test_an_archive_never_unpacks_over_another_object(server, tmp_path, capsys):
+    folder, url, _ = server
+    write_tgz(
+        folder / f"{YCB_ID}_google_16k.tgz",
+        {
+            f"{YCB_ID}/google_16k/textured.obj": cube_bytes(0.05, "obj"),
+            "025_mug/google_16k/textured.obj": cube_bytes(0.01, "obj"),  # another object's mesh
+        },
+    )
+    root = tmp_path / "data"
+    argv = ["dataset=ycb", f"dataset.root={root}", f"objects=[{YCB_ID}]", "--base-url", url, "progress=false"]
+    assert download.main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert "holds 025_mug/google_16k/textured.obj, outside 061_foam_brick/" in err and "\n" not in err
+    assert not (root / "ycb" / "025_mug").exists()
+
+
+@pytest.mark.parametrize("url", ["http://mirror.example.org/ycb/", "ftp://mirror.example.org/"])
+def test_a_first_download_must_come_over_https(tmp_path, capsys, url):
+    argv = [
+        "dataset=ycb",
+        f"dataset.root={tmp_path}",
+        f"objects=[{YCB_ID}]",
+        "--base-url",
+        url,
+        "progress=false",
+    ]
+    assert download.main(argv) == 2
+    assert "is not https" in capsys.readouterr().err

@@ -36,7 +36,7 @@ from graspexp.quality import fc_min_mu
 from graspexp.run.suites import PAPER_DATASETS, PAPER_MODES, PAPER_ROTS
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
-from graspexp.tools.cli import compose_checked, fail, take_sweep, tool_parser
+from graspexp.tools.cli import compose_checked, fail, positive_int, take_sweep, tool_parser
 
 PROG = "graspexp bench.shortlist"
 RULES = ("edge_clearance", "cost")
@@ -159,7 +159,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--out", type=Path, default=Path("shortlist.csv"), help="CSV written (default shortlist.csv)"
     )
-    ap.add_argument("--n-jobs", type=int, default=2, help="processes (default 2)")
+    ap.add_argument("--n-jobs", type=positive_int, default=2, help="processes (default 2)")
     args = ap.parse_intermixed_args(argv)
     if args.n_jobs < 1:
         fail(f"--n-jobs {args.n_jobs} is invalid: expected 1 or more processes", PROG)
