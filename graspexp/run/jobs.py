@@ -81,10 +81,11 @@ def job_failed(message: str) -> None:
     """Report that this job cannot run. A single run prints ``graspexp: error: <message>`` and exits 2; a
     multirun job prints it with its directory, records it for the sweep summary and returns."""
     hc = HydraConfig.get()
+    job_dir = Path(hc.runtime.output_dir)
+    _remove_if_empty(job_dir)  # Hydra made it for this job; a refused job leaves nothing behind
     if hc.mode != RunMode.MULTIRUN:
         print(f"graspexp: error: {message}", file=sys.stderr)
         raise SystemExit(2)
-    job_dir = Path(hc.runtime.output_dir)
     print(f"graspexp: error: job {job_dir.name}: {message}", file=sys.stderr)
     folder = job_dir.parent / FAILED_DIR / os.environ.get(SWEEP_ID_ENV, "unknown")
     try:
@@ -92,6 +93,13 @@ def job_failed(message: str) -> None:
         (folder / f"{hc.job.num:05d}.txt").write_text(f"{job_dir.name}: {message}\n")
     except OSError as exc:  # the summary will lack this job; its own line above says why
         print(f"graspexp: error: cannot record the failure of job {job_dir.name}: {exc}", file=sys.stderr)
+
+
+def _remove_if_empty(folder: Path) -> None:
+    try:
+        folder.rmdir()  # only succeeds for an empty folder
+    except OSError:
+        pass
 
 
 def writable_dir_problem(path: Path) -> str | None:

@@ -22,6 +22,7 @@ import os
 import platform
 import time
 import traceback
+from collections.abc import Callable
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
@@ -311,11 +312,12 @@ def quarantine(path: Path, run_dir: Path, why: str) -> Path:
     return target
 
 
-def check_resumable(cfg: DictConfig, run_dir: Path) -> None:
+def check_resumable(cfg: DictConfig, run_dir: Path, move_foreign: bool = True) -> None:
     """Raise RunError if a graspexp log in ``run_dir`` was made with a different config (see
     :mod:`graspexp.config.differences`); then move aside (:func:`quarantine`) the files in ``trials/`` that
     are not graspexp trial logs (no graspexp metadata, unreadable metadata): nothing is moved when the run
-    is refused. Partial logs and damaged results are left to :func:`_finished`."""
+    is refused, nor with ``move_foreign`` False (the check before the lock). Partial logs and damaged results
+    are left to :func:`_finished`."""
     foreign = []
     for path in iter_trial_logs(run_dir):
         try:
@@ -339,7 +341,7 @@ def check_resumable(cfg: DictConfig, run_dir: Path) -> None:
                 f"({path.relative_to(run_dir)}: {shown}); resume only reuses logs of the same config: "
                 f"choose another output directory (hydra.run.dir / hydra.sweep.dir) or delete {run_dir / 'trials'}"
             )
-    for path, why in foreign:
+    for path, why in foreign if move_foreign else ():
         quarantine(path, run_dir, why)
 
 
@@ -391,25 +393,60 @@ def run_job(cfg: DictConfig) -> float:
     """Run every trial for every selected object; returns the overall success rate in [0, 1]."""
     from hydra.core.hydra_config import HydraConfig
 
-    return run_in_dir(cfg, Path(HydraConfig.get().runtime.output_dir))
+    return run_in_dir(cfg, Path(HydraConfig.get().runtime.output_dir), write_hydra_record)
 
 
-def run_in_dir(cfg: DictConfig, run_dir: Path) -> float:
+def write_hydra_record(cfg: DictConfig, run_dir: Path) -> None:
+    """Hydra's record of an accepted run, ``.hydra/{config,hydra,overrides}.yaml`` (written here, after the
+    checks, rather than by Hydra before them: ``hydra.output_subdir`` is null in ``conf/config.yaml``)."""
+    from hydra.core.hydra_config import HydraConfig
+
+    hc = HydraConfig.get()
+    folder = run_dir / ".hydra"
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "config.yaml").write_text(OmegaConf.to_yaml(cfg))
+    (folder / "hydra.yaml").write_text(OmegaConf.to_yaml({"hydra": hc}))
+    (folder / "overrides.yaml").write_text(OmegaConf.to_yaml(list(hc.overrides.task)))
+
+
+def run_in_dir(
+    cfg: DictConfig, run_dir: Path, on_accepted: Callable[[DictConfig, Path], None] | None = None
+) -> float:
     """:func:`run_job` into ``run_dir`` (resumable, locked), outside a Hydra run (e.g. the benchmark). The
-    config is validated, then frozen: nothing in the job can change it (a write raises)."""
+    config is validated, then frozen: nothing in the job can change it (a write raises). ``on_accepted``
+    runs once every check that can refuse the run has passed (before the first trial)."""
     validate(cfg)
     OmegaConf.set_readonly(cfg, True)
-    with job_lock(run_dir), threadpool_limits(limits=1):  # trials are sequential: one core per job
-        return _run(cfg, run_dir)
+    with threadpool_limits(limits=1):  # trials are sequential: one core per job
+        return _run(cfg, run_dir, on_accepted)
 
 
-def _run(cfg: DictConfig, run_dir: Path) -> float:
+def _run(cfg: DictConfig, run_dir: Path, on_accepted: Callable[[DictConfig, Path], None] | None) -> float:
+    """The checks that need no lock and write nothing into ``run_dir`` (inputs, the logs' config), the
+    objects' loading, then under the lock the checks again and the trials: a refused run leaves
+    ``run_dir`` as it found it."""
     wall0, cpu0 = time.perf_counter(), time.process_time()
     objects = select_objects(cfg.dataset, cfg.objects)
-    check_resumable(cfg, run_dir)
+    check_resumable(cfg, run_dir, move_foreign=False)
     prepare_shapes(cfg.dataset, cfg.sim, objects, cfg.progress)
     models, unusable = load_models(cfg, objects)
-    check_same_meshes(run_dir, {name: loaded.model for name, loaded in models.items()})
+    with job_lock(run_dir):
+        check_resumable(cfg, run_dir)
+        check_same_meshes(run_dir, {name: loaded.model for name, loaded in models.items()})
+        if on_accepted is not None:
+            on_accepted(cfg, run_dir)
+        return _run_trials(cfg, run_dir, objects, models, unusable, wall0, cpu0)
+
+
+def _run_trials(
+    cfg: DictConfig,
+    run_dir: Path,
+    objects: list[str],
+    models: dict[str, LoadedObject],
+    unusable: dict[str, str],
+    wall0: float,
+    cpu0: float,
+) -> float:
     results: list[TrialResult] = []
     with tqdm(
         total=len(objects) * cfg.trials,

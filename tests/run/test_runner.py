@@ -57,10 +57,17 @@ def run_copy(finished_run: Path, tmp_path: Path) -> Path:
 
 
 @pytest.mark.slow
+def _snapshot(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
 def test_resume_refuses_logs_made_with_another_config(run_copy: Path) -> None:
     log = run_copy / "trials" / "can" / "000.mcap"
     before = log.read_bytes()
+    assert (run_copy / ".hydra" / "config.yaml").is_file()  # written once the run was accepted
+    snapshot = _snapshot(run_copy)
     line = _error_line(_run_job(run_copy, "mode=bin", "gripper=panda", "seed=7", *BASE))
+    assert _snapshot(run_copy) == snapshot  # nothing written, Hydra's .hydra/ included
     assert line.startswith(f"graspexp: error: {run_copy} holds trial logs made with a different config; ")
     assert "differing keys: gripper.name, mode.name, seed, " in line
     assert "mode.name: 'collab' in the log, 'bin' now" in line
