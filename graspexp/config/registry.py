@@ -7,10 +7,11 @@ from omegaconf import DictConfig, OmegaConf
 
 from graspexp.config.cost import CostConfig
 from graspexp.config.dataset import DatasetConfig
+from graspexp.config.errors import ConfigError
 from graspexp.config.gripper import GripperConfig
 from graspexp.config.job import JobConfig
 from graspexp.config.mode import ModeConfig
-from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
+from graspexp.config.plugins import LoadedPlanner, PluginError, get_plugin, load_planners
 from graspexp.config.rot import RotConfig
 from graspexp.config.sim import SimConfig
 
@@ -70,8 +71,16 @@ def register_configs() -> None:
 def job_config_from_yaml(text: str) -> DictConfig:
     """A job config recorded as YAML (e.g. a trial log's ``config_yaml``) typed again by its schemas, the
     ``planner`` node by the schema of the planner it names (:class:`PluginError` if none is installed)."""
-    data = OmegaConf.create(text)
-    planner = OmegaConf.structured(get_plugin(data.planner.name).plugin.config)
-    cfg = OmegaConf.merge(OmegaConf.structured(JobConfig), data)
-    cfg.planner = OmegaConf.merge(planner, data.planner)
+    try:
+        data = OmegaConf.create(text)
+        planner = OmegaConf.structured(get_plugin(data.planner.name).plugin.config)
+        cfg = OmegaConf.merge(OmegaConf.structured(JobConfig), data)
+        cfg.planner = OmegaConf.merge(planner, data.planner)
+    except PluginError:
+        raise
+    except Exception as exc:  # YAML, a list, unknown keys, wrong types: OmegaConf raises many kinds
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+        raise ConfigError(
+            f"the recorded config is not a graspexp job config ({type(exc).__name__}: {first})"
+        ) from None
     return cfg

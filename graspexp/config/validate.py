@@ -14,14 +14,10 @@ from omegaconf import DictConfig, OmegaConf
 
 from graspexp.config import cost, dataset, gripper, job, mode, rot, sim
 from graspexp.config.constraints import accepts, describe
+from graspexp.config.errors import ConfigError
 from graspexp.config.gripper_urdf import UrdfError
 from graspexp.config.plugins import PluginError, get_plugin
 from graspexp.config.registry import SCHEMAS, group_options
-
-
-class ConfigError(ValueError):
-    """A composed config holds a value the job cannot use."""
-
 
 SCHEMA_CONSTRAINTS: dict[type, dict[str, list]] = {
     job.JobConfig: job.JOB_CONSTRAINTS,

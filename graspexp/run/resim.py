@@ -1,13 +1,18 @@
 """Re-run a logged trial from its MCAP metadata and compare the outcome and the logged poses."""
 
+import os
+from pathlib import Path
+
 import numpy as np
 from omegaconf import OmegaConf
 
+from graspexp.config.errors import ConfigError
 from graspexp.config.registry import job_config_from_yaml
 from graspexp.datasets import job_object
+from graspexp.datasets.catalog import DATA_ENV
 from graspexp.planning import plan
 from graspexp.quality import fc_min_mu
-from graspexp.sim.collision_shapes import collision_shape
+from graspexp.sim.collision_shapes import shape_with_fallback
 from graspexp.sim.trial import NullRecorder, TrialContext, run_trial
 
 POSE_TOLERANCE = 1e-6
@@ -31,19 +36,32 @@ def resimulate(log) -> tuple[bool, str]:
     """Rebuild the trial in ``log`` (a :class:`graspexp.record.TrialLog`), run it, compare.
 
     Returns (agrees, explanation): agrees when success, failure reason and every logged frame pose
-    match within :data:`POSE_TOLERANCE`.
+    match within :data:`POSE_TOLERANCE`. The mesh is read from the config's ``dataset.root``, else
+    ``$GRASPEXP_DATA``, else the data root the log recorded (when it exists here).
     """
     meta = log.metadata
+    missing = [k for k in ("config_yaml", "object", "trial", "trial_seed") if k not in meta]
+    if missing or not (str(meta.get("trial", "")).isdigit() and str(meta.get("trial_seed", "")).isdigit()):
+        raise ConfigError(f"the log's metadata lacks a valid {', '.join(missing) or 'trial / trial_seed'}")
     cfg = job_config_from_yaml(meta["config_yaml"])
+    recorded_root = meta.get("data_root")
+    if (
+        cfg.dataset.root is None
+        and recorded_root
+        and Path(recorded_root).is_dir()
+        and not os.environ.get(DATA_ENV)
+    ):
+        cfg.dataset.root = recorded_root  # the folder the trial read its mesh from, when no other is named
     plain = OmegaConf.to_object(cfg)
     name, trial, seed = meta["object"], int(meta["trial"]), int(meta["trial_seed"])
     model = job_object(cfg, name)
     capture = _PoseCapture()
+    shape, _ = shape_with_fallback(model.mesh, plain.sim)
     result = run_trial(
         TrialContext(
             plain,
             model,
-            collision_shape(model.mesh, plain.sim),
+            shape,
             trial,
             seed,
             capture,
@@ -59,6 +77,10 @@ def resimulate(log) -> tuple[bool, str]:
             f"mesh differs: the log was made on {meta.get('mesh_source') or 'a procedural mesh'} (sha256 "
             f"{recorded[:12]}), this data root gives {model.source or 'a procedural mesh'} (sha256 "
             f"{model.mesh_sha256[:12]})"
+        )
+    if meta.get("collision_method", shape.method) != shape.method:
+        problems.append(
+            f"collision method differs: {meta['collision_method']} in the log, {shape.method} now"
         )
     if bool(logged.get("success")) != result.success or logged.get("reason") != result.reason:
         problems.append(

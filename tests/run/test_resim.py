@@ -49,3 +49,45 @@ def test_resim_without_the_mesh_is_one_line(tmp_path, monkeypatch, capsys):
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and err[0].startswith("graspexp replay: error: cannot re-simulate ")
     assert "download it with: python -m graspexp download" in err[0]
+
+
+@pytest.mark.parametrize(
+    "meta, message",
+    [
+        (
+            {"config_yaml": "- 1\n- 2", "object": "can", "trial": "0", "trial_seed": "1"},
+            "not a graspexp job config",
+        ),
+        (
+            {"config_yaml": "{{{", "object": "can", "trial": "0", "trial_seed": "1"},
+            "not a graspexp job config",
+        ),
+        ({"config_yaml": "{}"}, "metadata lacks a valid object, trial, trial_seed"),
+    ],
+)
+def test_resim_of_a_log_with_a_junk_config_is_one_line(tmp_path, capsys, meta, message):
+    from graspexp.core.outcome import TrialResult
+    from graspexp.record import TrialRecorder
+    from graspexp.tools.replay import main as replay_main
+
+    path = tmp_path / "junk.mcap"
+    with TrialRecorder(path, meta) as rec:
+        rec.result(
+            0.0, TrialResult("primitives", "can", "collab", "z", "optimal", 0, 1, True, None).to_dict()
+        )
+    assert replay_main([str(path), "--resim"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and message in err[0]
+
+
+def test_resim_finds_the_mesh_in_the_recorded_data_root(tmp_path, monkeypatch):
+    root = shared_data_root()
+    if not (root / "ycb" / "025_mug").is_dir():
+        pytest.skip(f"no YCB meshes under {root}")
+    monkeypatch.setenv("GRASPEXP_DATA", str(root))
+    run_in_dir(compose_config(["dataset=ycb", "objects=[025_mug]", "trials=1", "progress=false"]), tmp_path)
+    monkeypatch.delenv("GRASPEXP_DATA")
+    log = read_trial(tmp_path / "trials" / "025_mug" / "000.mcap")
+    assert log.metadata["data_root"] == str(root.resolve())
+    agrees, why = resimulate(log)
+    assert agrees, why
