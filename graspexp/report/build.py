@@ -21,7 +21,7 @@ import pandas as pd
 from graspexp.record import CorruptLogError, read_trial
 from graspexp.report.agreement import Agreement, agreement, agreement_chart, example_trials
 from graspexp.report.charts import success_chart
-from graspexp.report.collect import Collected, collect
+from graspexp.report.collect import FINGERPRINT_COLUMN, Collected, collect
 from graspexp.report.contact_area import held_in_area
 from graspexp.report.gallery import draw_trial, write_gallery
 from graspexp.report.paper import PLANNER_RUNTIME_S
@@ -239,6 +239,14 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
     md += _unreadable_section(col)
     if col.unreadable:
         pd.DataFrame(col.unreadable, columns=["path", "reason"]).to_csv(out / "unreadable.csv", index=False)
+    if FINGERPRINT_COLUMN in col.results:
+        counts = col.results[FINGERPRINT_COLUMN].fillna("results.csv only (no log)").value_counts()
+        md += ["## Machines and versions", ""]
+        md += [
+            "Trial results may depend on the CPU and the libraries (README, Determinism); these logs were made on:",
+            "",
+        ]
+        md += [f"- {n} trials: {name}" for name, n in counts.items()] + [""]
     if col.duplicates:
         md += [
             f"## Duplicate trials ({len(col.duplicates)})",

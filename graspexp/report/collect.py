@@ -19,7 +19,7 @@ import yaml
 from graspexp.config.differences import result_config
 from graspexp.core.outcome import result_from_dict
 from graspexp.record import TRIALS_DIR, CorruptLogError, read_result
-from graspexp.record.reader import read_config_yaml
+from graspexp.record.reader import read_metadata
 from graspexp.record.writer import PARTIAL_SUFFIX
 
 SETTING_KEYS: tuple[str, ...] = ("dataset", "planner", "mode", "rot")
@@ -29,6 +29,15 @@ NOISE_KEYS: tuple[str, ...] = ("trans_mm", "rot_deg")
 TRIAL_KEYS: tuple[str, ...] = (*SETTING_KEYS, *NOISE_KEYS, "object", "trial")
 """One trial is identified by these fields."""
 RESULTS_CSV = "results.csv"
+FINGERPRINT_COLUMN = "machine"
+"""Column of :func:`collect`: where a log was made (:func:`fingerprint`); empty for results.csv rows."""
+FINGERPRINT_KEYS = (
+    "machine.cpu",
+    "machine.cpu_flags_sha256",
+    "version.sapien",
+    "version.numpy",
+    "version.graspexp",
+)
 CONFIG_COLUMN = "_config"
 """Working column of :func:`collect`: each log's result-affecting config, flattened (dropped before return)."""
 """The runner's per-run cache of its trials' results."""
@@ -80,7 +89,8 @@ def _log_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
     for path in find_trial_logs(root):
         try:
             result = read_result(path)  # checks the whole file first (magic, CRCs, truncation)
-            config_yaml = read_config_yaml(path)
+            meta = read_metadata(path) or {}
+            config_yaml = meta.get("config_yaml")
             if config_yaml is None:
                 raise CorruptLogError(f"{path}: not a graspexp trial log (no graspexp metadata)")
             config = yaml.safe_load(config_yaml)
@@ -92,6 +102,7 @@ def _log_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
             continue
         row = _row(result, path, noise_of(config))
         row[CONFIG_COLUMN] = result_config(config)
+        row[FINGERPRINT_COLUMN] = fingerprint(meta)
         rows.append(row)
     return rows, unreadable
 
@@ -132,6 +143,16 @@ def collect(root: Path | str) -> Collected:
         check_one_config_per_cell(df)
         df = df.drop(columns=CONFIG_COLUMN, errors="ignore")
     return Collected(root=root, results=df, unreadable=unreadable, duplicates=duplicates)
+
+
+def fingerprint(meta: dict[str, str]) -> str:
+    """The machine and library versions a log records (CPU, its flags' hash, SAPIEN, numpy, graspexp), one
+    string: results may depend on them, so a report says which it mixes ("unrecorded" for older logs)."""
+    values = [meta.get(k) for k in FINGERPRINT_KEYS]
+    if all(v is None for v in values):
+        return "unrecorded"
+    cpu, flags, sapien, numpy, graspexp = (v or "?" for v in values)
+    return f"{cpu} (flags {flags}), sapien {sapien}, numpy {numpy}, graspexp {graspexp}"
 
 
 class MixedConfigError(ValueError):
