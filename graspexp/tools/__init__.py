@@ -12,6 +12,7 @@ TOOLS: tuple[str, ...] = (
     "download",
     "prepare",
     "area",
+    "config_reference",
     "bench.trials",
     "bench.plan_latency",
     "bench.collision_shapes",
