@@ -3,9 +3,13 @@ config group and installed planner (read here straight from the schemas, indepen
 the tutorials' tested command blocks run, and the README stays short with its commands runnable."""
 
 import dataclasses
+import os
 import re
+import subprocess
 import typing
 from pathlib import Path
+
+import pytest
 
 import graspexp
 from graspexp.config.job import JobConfig
@@ -67,3 +71,50 @@ def test_the_reference_tool_writes_the_page(tmp_path):
 
     assert config_reference.main(["--out", str(tmp_path / "c.md")]) == 0
     assert (tmp_path / "c.md").read_text() == render()
+
+
+def marked_blocks(page: Path) -> list[str]:
+    """The fenced ``bash`` blocks of ``page`` right below a ``<!-- tested -->`` line, in order."""
+    blocks, lines = [], page.read_text().splitlines()
+    for i, line in enumerate(lines[:-1]):
+        if line.strip() == TESTED and lines[i + 1].startswith("```bash"):
+            end = next(j for j in range(i + 2, len(lines)) if lines[j].startswith("```"))
+            blocks.append("\n".join(lines[i + 2 : end]))
+    return blocks
+
+
+TUTORIALS = sorted(p for p in DOCS.rglob("*.md") if marked_blocks(p))
+
+
+def test_every_tutorial_has_a_tested_block():
+    untested = [
+        p.name for p in (DOCS / "tutorials").glob("*.md") if p.name != "index.md" and p not in TUTORIALS
+    ]
+    assert not untested, f"tutorials without a <!-- tested --> block: {untested}"
+
+
+@pytest.mark.slow
+@pytest.mark.sim
+@pytest.mark.parametrize("page", TUTORIALS, ids=lambda p: str(p.relative_to(DOCS)))
+def test_the_tested_commands_of_a_page_run_as_written(page, tmp_path):
+    """Each page's tested blocks run in order in one fresh folder that holds a link to the checkout's
+    ``examples/`` (the tutorials run from the checkout's root), with this checkout first on the path."""
+    (tmp_path / "examples").symlink_to(ROOT / "examples")
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH", "")])),
+        "OMP_NUM_THREADS": "1",
+        "GRASPEXP_CACHE": os.environ.get("GRASPEXP_CACHE", str(tmp_path / ".cache")),
+    }
+    for block in marked_blocks(page):
+        proc = subprocess.run(
+            ["bash", "-euo", "pipefail", "-c", block],
+            cwd=tmp_path,
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
+        assert proc.returncode == 0, (
+            f"{page.name}: block failed ({proc.returncode}):\n{block}\n{proc.stdout[-2000:]}\n{proc.stderr[-3000:]}"
+        )
