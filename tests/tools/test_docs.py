@@ -5,7 +5,9 @@ the tutorials' tested command blocks run, and the README stays short with its co
 import dataclasses
 import os
 import re
+import shlex
 import subprocess
+import sys
 import typing
 from pathlib import Path
 
@@ -118,3 +120,99 @@ def test_the_tested_commands_of_a_page_run_as_written(page, tmp_path):
         assert proc.returncode == 0, (
             f"{page.name}: block failed ({proc.returncode}):\n{block}\n{proc.stdout[-2000:]}\n{proc.stderr[-3000:]}"
         )
+
+
+FRESH_INSTALL = (
+    "python3 -m venv .venv && . .venv/bin/activate && pip install -e '.[test]' && python -m graspexp"
+)
+"""The README's first command (CI and other tools rely on it, word for word)."""
+FRESH_TESTS = ". .venv/bin/activate && GRASPEXP_DATA=../shared/datasets python -m pytest -q"
+"""The README's second command."""
+README_LIMIT = 200
+"""Most lines the README may have: a newcomer reads it in five minutes; the rest lives in ``docs/``."""
+
+
+def _bash_blocks(text: str) -> list[list[str]]:
+    blocks, block = [], None
+    for line in text.splitlines():
+        if block is None and line.startswith("```bash"):
+            block = []
+        elif block is not None and line.startswith("```"):
+            blocks.append(block)
+            block = None
+        elif block is not None:
+            block.append(line)
+    return blocks
+
+
+def readme_commands() -> list[str]:
+    """Every ``python -m graspexp...`` and ``nox`` command of the README's bash blocks, continuation lines
+    joined and trailing comments dropped."""
+    out = []
+    for block in _bash_blocks(README.read_text()):
+        joined = re.sub(r"\\\n\s*", "", "\n".join(block))
+        for line in joined.splitlines():
+            cmd = re.sub(r"\s+#\s.*$", "", line).strip()
+            if cmd.startswith(("python -m graspexp", "nox ")):
+                out.append(cmd)
+    return out
+
+
+def _first_value(arg: str) -> str:
+    """``key=a,b`` -> ``key=a`` (a list value ``key=[a,b]`` stays whole)."""
+    key, sep, value = arg.partition("=")
+    return f"{key}={value.split(',')[0]}" if sep and not value.startswith("[") else arg
+
+
+def dry_form(cmd: str, env: dict[str, str]) -> list[str]:
+    """The command as a cheap check: a tool's ``--help``; a job's composed config (``--cfg job``, the first
+    value of each swept key, without ``-m``), which validates every override as the run would."""
+    from graspexp.tools import TOOLS
+
+    words = shlex.split(cmd.replace("$PARTITION", env["PARTITION"]))
+    module, args = words[2], words[3:]
+    python = [sys.executable, "-m", module]
+    if module != "graspexp":  # python -m graspexp.area, graspexp.run.suites
+        return [*python, "--help"]
+    if args and args[0] in TOOLS:
+        return [*python, args[0], "--help"]
+    return [*python, "--cfg", "job", *(_first_value(a) for a in args if a != "-m")]
+
+
+def test_the_readme_is_short_and_opens_with_the_two_fresh_machine_commands():
+    text = README.read_text()
+    assert len(text.splitlines()) <= README_LIMIT, f"README.md has {len(text.splitlines())} lines"
+    assert _bash_blocks(text)[:2] == [[FRESH_INSTALL], [FRESH_TESTS]]
+    assert "python -m graspexp.area" in text and "gripper=urdf gripper.urdf=" in text
+    links = re.findall(r"\]\(([^)#]+)(?:#[^)]*)?\)", text)
+    dead = [link for link in links if "://" not in link and not (ROOT / link).exists()]
+    assert not dead, f"README links to missing files: {dead}"
+
+
+@pytest.mark.slow
+def test_every_readme_command_runs_in_its_dry_form(tmp_path):
+    """Tools answer ``--help``, jobs compose and validate (``--cfg job``) from a folder that holds the
+    README's example inputs (``my_parts/bracket.stl``, ``my_gripper/gripper.urdf``); nox sessions exist."""
+    import trimesh
+    from conftest import write_urdf_gripper
+
+    (tmp_path / "my_parts").mkdir()
+    trimesh.creation.box((50, 30, 80)).export(tmp_path / "my_parts" / "bracket.stl")
+    (tmp_path / "my_gripper").mkdir()
+    write_urdf_gripper(tmp_path / "my_gripper")
+    env = {
+        **os.environ,
+        "PARTITION": "debug",
+        "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH", "")])),
+    }
+    sessions = set(re.findall(r"^def (\w+)\(session", (ROOT / "noxfile.py").read_text(), flags=re.M))
+    commands = readme_commands()
+    assert len(commands) >= 12, commands
+    for cmd in commands:
+        if cmd.startswith("nox "):
+            assert cmd.split()[2] in sessions, cmd
+            continue
+        proc = subprocess.run(
+            dry_form(cmd, env), cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120
+        )
+        assert proc.returncode == 0, f"{cmd}\n-> {dry_form(cmd, env)}\n{proc.stderr[-2000:]}"
