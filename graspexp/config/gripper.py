@@ -17,6 +17,7 @@ from graspexp.config.gripper_urdf import LEFT, PALM, RIGHT, HandMeshes, load_han
 @dataclass
 class GripperConfig:
     name: str = MISSING
+    """The gripper's name in logs and tables (the option's: ``rg2``, ``robotiq_2f85``, ``panda``, ``urdf``)."""
     max_width_m: float = MISSING
     """Largest opening between the finger pads (stroke), m."""
     min_width_m: float = 0.0

@@ -10,19 +10,28 @@ class SimConfig:
     timestep_s: float = 1.0 / 240.0
     """Physics step, s."""
     solver_position_iterations: int = 20
+    """PhysX solver position iterations per step (every body; ``sapien.physx.set_body_config``)."""
     solver_velocity_iterations: int = 1
+    """PhysX solver velocity iterations per step (every body)."""
     enable_tgs: bool = False
     """TGS solver; off because a flat box on a single hull slides forever with TGS on."""
     contact_offset_m: float = 0.002
+    """PhysX contact offset of every shape: contacts are generated within this distance, m (above
+    ``rest_offset_m``)."""
     rest_offset_m: float = 0.0
+    """PhysX rest offset of every shape: the separation at which touching shapes come to rest, m."""
     object_static_friction: float = 0.6
+    """Static friction coefficient of the object (an object's sidecar ``friction`` overrides it), 1."""
     object_dynamic_friction: float = 0.5
+    """Dynamic friction coefficient of the object (an object's sidecar ``friction`` overrides it), 1."""
     support_friction: float = 0.6
+    """Static and dynamic friction coefficient of the support (box or table), 1."""
     object_angular_damping: float = 0.5
     """Angular velocity damping of the object, 1/s: stands in for rolling resistance (PhysX has none)."""
     settle_max_s: float = 3.0
     """Time cap for the drop to come to rest, s."""
     settle_min_s: float = 0.3
+    """The drop is not taken as settled before this time has passed, s (at most ``settle_max_s``)."""
     settle_linear_mps: float = 0.005
     """Object counts as settled below this linear speed, m/s."""
     settle_angular_radps: float = 0.05
