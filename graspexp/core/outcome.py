@@ -31,7 +31,7 @@ class FailureReason(str, enum.Enum):
 
 @dataclass
 class TrialResult:
-    """One row of the results table; also the ``graspexp.TrialResult@2`` MCAP message."""
+    """One row of the results table; also the ``graspexp.TrialResult@3`` MCAP message."""
 
     dataset: str
     object: str

@@ -53,7 +53,8 @@ def check_obj(path: Path, data: bytes) -> None:
 
 
 def check_ply(path: Path, data: bytes) -> None:
-    """Raise DatasetError if the PLY body is shorter than its header's element counts say."""
+    """Raise ObjectError if an ASCII PLY body holds other than the rows its header's element counts say, or a
+    binary body fewer bytes than they need."""
     end = data.find(b"end_header")
     if not data.startswith(b"ply") or end < 0:
         raise _damaged(path, "no complete PLY header")
@@ -76,7 +77,7 @@ def check_ply(path: Path, data: bytes) -> None:
     if fmt == "ascii":
         rows = sum(1 for ln in body.split(b"\n") if ln.strip())
         needed = sum(count for _, count, _, _ in elements)
-        if rows < needed:
+        if rows != needed:  # exact: rows beyond the declared counts are data the reader would drop
             counts = ", ".join(f"{count} {name}" for name, count, _, _ in elements)
             raise _damaged(path, f"its header declares {counts} ({needed} rows), the file holds {rows} rows")
     else:

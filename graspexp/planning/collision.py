@@ -31,7 +31,7 @@ import numpy as np
 from graspexp.config import GripperConfig
 from graspexp.config.gripper import GripperGeometry
 from graspexp.planning.hull_sweep import hull_cloud_hits, hull_lowest_z
-from graspexp.planning.kernels import swept_box_hits
+from graspexp.planning.kernels import COUNT_ALL, swept_box_hits
 from graspexp.planning.pose import slab_spans_m
 
 
@@ -67,9 +67,11 @@ def cloud_hits(
     *,
     sweep_m: float,
     margin_m: float,
+    stop_at: int = COUNT_ALL,
 ) -> np.ndarray:
     """Number of cloud points inside the swept finger and palm boxes (or URDF pieces) (module doc), per
-    grasp. Compiled (:func:`graspexp.planning.kernels.swept_box_hits`).
+    grasp, counted up to ``stop_at`` (``stop_at=1``: the scan of a grasp ends at its first hit, for a
+    free / not free test). Compiled (:func:`graspexp.planning.kernels.swept_box_hits`).
 
     points_m : (N, 3) world; poses : (B, 4, 4) world; widths_m : (B,) or scalar openings, m.
 
@@ -81,7 +83,9 @@ def cloud_hits(
     widths = np.broadcast_to(np.asarray(widths_m, dtype=np.float64), (len(poses),))
     geometry = GripperGeometry.of(gripper)
     if geometry.hand is not None:
-        return hull_cloud_hits(points_m, poses, geometry.hand, widths, sweep_m=sweep_m, margin_m=margin_m)
+        return hull_cloud_hits(
+            points_m, poses, geometry.hand, widths, sweep_m=sweep_m, margin_m=margin_m, stop_at=stop_at
+        )
     fw, t = geometry.finger_width_m, geometry.finger_thickness_m
     px, py, pz = geometry.palm_size_m
     root, tip = geometry.root_z_m, geometry.tip_z_m
@@ -94,6 +98,7 @@ def cloud_hits(
         np.ascontiguousarray(widths / 2),
         finger,
         palm,
+        stop_at,
     )
 
 
@@ -230,7 +235,7 @@ def place_grasps(
     hits = np.zeros(b, dtype=np.int64)
     if check.any():
         hits[check] = cloud_hits(
-            points_m, poses[check], gripper, widths[check], sweep_m=sweep_m, margin_m=margin_m
+            points_m, poses[check], gripper, widths[check], sweep_m=sweep_m, margin_m=margin_m, stop_at=1
         )
     collides = check & (hits > 0)
     return Placement(

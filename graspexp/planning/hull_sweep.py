@@ -15,7 +15,7 @@ import numpy as np
 from scipy.spatial import ConvexHull
 
 from graspexp.config.gripper_urdf import SLIDE, HandMeshes
-from graspexp.planning.kernels import swept_hull_hits
+from graspexp.planning.kernels import COUNT_ALL, swept_hull_hits
 
 
 def _swept_vertices(hull: np.ndarray, sweep_m: float) -> np.ndarray:
@@ -57,9 +57,10 @@ def hull_cloud_hits(
     *,
     sweep_m: float,
     margin_m: float,
+    stop_at: int = COUNT_ALL,
 ) -> np.ndarray:
     """(B,) number of cloud points (N, 3) world inside the swept pieces grown by ``margin_m`` (module doc),
-    for (B, 4, 4) world grasp poses and (B,) openings, m; 0 means collision-free."""
+    for (B, 4, 4) world grasp poses and (B,) openings, m, counted up to ``stop_at``; 0 means collision-free."""
     normals, offsets, slides = _half_spaces(hand, sweep_m)
     grown = np.where(np.any(normals != 0, axis=2), offsets + margin_m, 1.0)
     swept = [_swept_vertices(h, sweep_m) for h in hand.hulls]
@@ -74,4 +75,5 @@ def hull_cloud_hits(
         slides,
         lo,
         hi,
+        stop_at,
     )

@@ -419,6 +419,10 @@ def pad_edge_excess(
     return out
 
 
+COUNT_ALL = np.iinfo(np.int64).max
+"""``stop_at`` of the swept-volume kernels that counts every point (no early stop)."""
+
+
 @_jit
 def swept_box_hits(
     points: np.ndarray,
@@ -426,11 +430,13 @@ def swept_box_hits(
     half_widths: np.ndarray,
     finger: np.ndarray,
     palm: np.ndarray,
+    stop_at: int,
 ) -> np.ndarray:
     """Points inside the swept finger and palm boxes of each grasp (:func:`graspexp.planning.collision.
     cloud_hits`). points : (N, 3) world; poses : (B, 4, 4); half_widths : (B,) half openings, m;
     finger : [half x, thickness, z lo, z hi, margin]; palm : [half x, half y, z lo, z hi], margin included
-    except in ``finger``'s y bounds. Returns (B,) int64."""
+    except in ``finger``'s y bounds; a grasp's count stops at ``stop_at`` (1: is it free?). Returns (B,)
+    int64."""
     out = np.zeros(poses.shape[0], dtype=np.int64)
     fx, ft, fz0, fz1, m = finger[0], finger[1], finger[2], finger[3], finger[4]
     px, py, pz0, pz1 = palm[0], palm[1], palm[2], palm[3]
@@ -449,6 +455,8 @@ def swept_box_hits(
             in_palm = x <= px and y <= py and pz0 <= z <= pz1
             if in_finger or in_palm:
                 count += 1
+                if count >= stop_at:
+                    break
         out[b] = count
     return out
 
@@ -463,13 +471,14 @@ def swept_hull_hits(
     slides: np.ndarray,
     lo: np.ndarray,
     hi: np.ndarray,
+    stop_at: int,
 ) -> np.ndarray:
     """Points inside any swept convex piece of each grasp (:func:`graspexp.planning.hull_sweep.
     hull_cloud_hits`). points : (N, 3) world; poses : (B, 4, 4); half_widths : (B,) half openings, m;
     normals : (P, F, 3) and offsets : (P, F) the pieces' half-spaces ``n . p <= offset`` at zero opening,
     margin included (padding rows: zero normal, offset 1); slides : (P,) +1, -1 or 0, how half the opening
-    moves a piece along +Y; lo, hi : (P, 3) the pieces' bounding boxes at zero opening, margin included.
-    Returns (B,) int64."""
+    moves a piece along +Y; lo, hi : (P, 3) the pieces' bounding boxes at zero opening, margin included; a
+    grasp's count stops at ``stop_at`` (1: is it free?). Returns (B,) int64."""
     out = np.zeros(poses.shape[0], dtype=np.int64)
     for b in range(poses.shape[0]):
         r = poses[b]
@@ -499,5 +508,7 @@ def swept_hull_hits(
                 if inside:
                     count += 1
                     break
+            if count >= stop_at:
+                break
         out[b] = count
     return out

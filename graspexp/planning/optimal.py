@@ -370,7 +370,7 @@ def _test_batch(
     if pl.swept_check:
         poses[:, :3, 3] += _centre_shifts_m(pl, spans)[:, None] * rots[:, :, 1]
         widths = _opened_widths_m(pl, gr, extent, openings[ks])
-        free = cloud_hits(points, poses, gr, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0) == 0
+        free = cloud_hits(points, poses, gr, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0, stop_at=1) == 0
         if req.support_blocks_gripper:
             free &= lowest_z(poses, gr, widths, pl.sphere_radius_m) >= req.table_z
         tests.free[ks, ps] = free

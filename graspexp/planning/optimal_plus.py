@@ -314,7 +314,10 @@ def _noise_pass(
     ok = np.zeros(len(poses))
     for motion in motions:
         moved = transform_points(motion, points)
-        free = cloud_hits(moved, poses, req.gripper, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0) == 0
+        free = (
+            cloud_hits(moved, poses, req.gripper, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0, stop_at=1)
+            == 0
+        )
         held, _, share = _pads_hold(pl, geometry, moved, normals @ motion[:3, :3].T, req.area_mask, poses)
         ok += free & held & (share >= min_share)
     return ok / len(motions)

@@ -215,7 +215,8 @@ class _Log:
             return "", None
         encoding = S.MESSAGE_ENCODING if expected in S.SCHEMAS else S.PROTOBUF
         schema = self.schemas[ch.id]
-        if ch.message_encoding != encoding or schema is None or schema.name != expected:
+        accepted = S.READABLE_RESULTS if expected == S.TRIAL_RESULT else (expected,)
+        if ch.message_encoding != encoding or schema is None or schema.name not in accepted:
             raise CorruptLogError(
                 f"{self.name}: topic {ch.topic} has encoding {ch.message_encoding!r} / schema "
                 f"{self.topics[ch.topic]!r}, expected {encoding!r} / {expected!r}"
@@ -385,7 +386,7 @@ def read_result(path: Path | str) -> dict:
     if found is None:
         raise CorruptLogError(f"{name}: no /result message (the trial did not finish)")
     channel, schema_name, message = found
-    if schema_name != S.TRIAL_RESULT or channel.message_encoding != S.MESSAGE_ENCODING:
+    if schema_name not in S.READABLE_RESULTS or channel.message_encoding != S.MESSAGE_ENCODING:
         raise CorruptLogError(f"{name}: /result has schema {schema_name!r}, expected {S.TRIAL_RESULT!r}")
     try:
         result = S.restore_nan(json.loads(message.data), S.SCHEMAS[S.TRIAL_RESULT])

@@ -32,7 +32,9 @@ POSE_IN_FRAME = "foxglove.PoseInFrame"
 POINT_CLOUD = "foxglove.PointCloud"
 PLANNED_GRASP = "graspexp.PlannedGrasp@1"
 PHASE = "graspexp.Phase@1"
-TRIAL_RESULT = "graspexp.TrialResult@2"
+TRIAL_RESULT = "graspexp.TrialResult@3"
+READABLE_RESULTS = (TRIAL_RESULT, "graspexp.TrialResult@2")
+"""/result schemas the readers accept: @2 is @3 without ``at_rest`` (then True: the cap was not checked)."""
 
 TOPIC_SCENE = "/scene"
 TOPIC_TF = "/tf"

@@ -105,3 +105,14 @@ def test_closed_mesh_enclosing_more_than_its_hull_is_refused(tmp_path: Path) -> 
     with pytest.raises(DatasetError, match=r"it is closed but encloses 0.00025 m\^3 against a convex hull"):
         load_object(_cfg("ycb", tmp_path), "061_foam_brick", 64, 0)
     assert np.isclose(a.volume, 0.05**3)
+
+
+def test_an_ascii_ply_with_more_rows_than_declared_is_refused(tmp_path):
+    path = tmp_path / "cube.ply"
+    text = trimesh.creation.box(extents=(0.05, 0.05, 0.05)).export(file_type="ply", encoding="ascii")
+    path.write_bytes(text + b"3 0 1 2\n")  # a face the header does not declare
+    cfg = DatasetConfig(name="cube", layout="folder", root=str(tmp_path))
+    with pytest.raises(
+        DatasetError, match=r"its header declares 8 vertex, 12 face \(20 rows\), the file holds 21"
+    ):
+        load_object(cfg, "cube", 16, 0)

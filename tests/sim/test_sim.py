@@ -203,3 +203,26 @@ def test_a_settle_cap_that_runs_out_is_said_not_logged_as_settled():
     capture = ContactCapture()
     res = run_trial(_ctx(recorder=capture))
     assert res.at_rest is True and "settled" in capture.phases and "settle_timeout" not in capture.phases
+
+
+def test_a_gripper_link_that_explodes_is_sim_unstable_not_a_failed_grasp():
+    from types import SimpleNamespace
+
+    from graspexp.sim.trial import TrialFailed, _check_gripper_stable
+
+    def link(name, p, v):
+        pose = SimpleNamespace(p=np.array(p, dtype=float), q=np.array([1.0, 0.0, 0.0, 0.0]))
+        return SimpleNamespace(
+            name=name, entity_pose=pose, get_linear_velocity=lambda: np.array(v, dtype=float)
+        )
+
+    sim = SimpleNamespace(max_speed_sq=10.0**2)
+    calm = SimpleNamespace(
+        palm=link("palm", [0, 0, 0.2], [0, 0, 0]), fingers=(link("l", [0, 0, 0.1], [0, 0, 0.1]),)
+    )
+    _check_gripper_stable(sim, calm)  # no exception
+    for bad in (link("l", [np.nan, 0, 0], [0, 0, 0]), link("l", [0, 0, 0.1], [0, 50.0, 0])):
+        gripper = SimpleNamespace(palm=calm.palm, fingers=(bad,))
+        with pytest.raises(TrialFailed) as exc:
+            _check_gripper_stable(sim, gripper)
+        assert exc.value.reason == FailureReason.SIM_UNSTABLE

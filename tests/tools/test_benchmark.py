@@ -103,3 +103,10 @@ def test_each_planner_launches_as_one_hydra_multirun_into_the_job_directories():
     assert {"hydra/launcher=submitit_slurm", "hydra.launcher.partition=gpu"} <= set(
         sweep_command(slurm, todo)
     )
+
+
+def test_n_jobs_below_one_is_refused_before_any_work(capsys):
+    with pytest.raises(SystemExit) as exc:
+        parse_args(["planner=obb", "--n-jobs", "0"])
+    assert exc.value.code == 2
+    assert "argument --n-jobs: expected an integer >= 1, got 0" in capsys.readouterr().err
