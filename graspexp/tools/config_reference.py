@@ -149,7 +149,8 @@ def schema_keys(schema: type, prefix: str, constraints: dict[str, list] | None =
 
 
 def _md(text: str) -> str:
-    """reStructuredText-flavoured docstring text as one Markdown table cell."""
+    """reStructuredText-flavoured docstring text as one Markdown table cell (a pipe inside a code span
+    needs no escape: Python-Markdown's tables skip code spans)."""
     text = re.sub(r":[a-z]+:`~?([^`]+)`", r"``\1``", text)  # :class:`x` -> ``x``
     parts = re.split(r"(``[^`]+``|`[^`]+`)", " ".join(text.split()))
     out = []
@@ -169,9 +170,7 @@ def _table(keys: list[Key]) -> list[str]:
         doc = _md(k.doc)
         if k.before:
             doc += f" (added later; runs before it behaved as `{k.before}`)"
-        lines.append(
-            f"| `{k.dotted}` | `{_md(k.type)}` | {k.unit} | `{_md(k.default)}` | {_md(k.allowed)} | {doc} |"
-        )
+        lines.append(f"| `{k.dotted}` | `{k.type}` | {k.unit} | `{k.default}` | {_md(k.allowed)} | {doc} |")
     return lines
 
 
@@ -199,7 +198,7 @@ def _options(group: str, keys: list[Key], options: list[str]) -> list[str]:
     lines = ["| option | values it sets that differ from the schema's defaults |", "|---|---|"]
     for option in options:
         changed = [
-            f"`{key}={_md(_show(v))}`"
+            f"`{key}={_show(v)}`"
             for key, v in _flat(preset_values(group, option), f"{group}.").items()
             if defaults.get(key) != _show(v) and key != f"{group}.name"
         ]
