@@ -258,3 +258,25 @@ def test_every_key_of_graspexp_has_a_docstring():
     rows = [re.split(r"(?<!\\)\|", r) for r in checked.splitlines() if r.startswith("| `")]
     empty = [cells[1].strip() for cells in rows if len(cells) == 8 and not cells[6].strip()]
     assert not empty, f"keys without a docstring: {empty}"
+
+
+@pytest.mark.parametrize("page", [README, DOCS / "guide" / "config_groups.md"], ids=lambda p: p.name)
+def test_the_hand_written_group_tables_list_every_option(page):
+    """The groups tables in words (README, guide) name every option graspexp ships for each group."""
+    rows = {
+        line.split("|")[1].strip(" `"): line
+        for line in page.read_text().splitlines()
+        if line.startswith("| `")
+    }
+    own = {
+        n
+        for n, p in load_planners().items()
+        if isinstance(p, LoadedPlanner) and p.package.startswith("graspexp ")
+    }
+    missing = [
+        f"{group}={option}"
+        for group in (*SCHEMAS, "planner")
+        for option in group_options(group)
+        if (group != "planner" or option in own) and f"`{option}`" not in rows.get(group, "")
+    ]
+    assert not missing, f"{page.name} does not list {missing}"
