@@ -1,0 +1,113 @@
+#!/usr/bin/env bash
+# A one-node SLURM cluster on this host from Debian 12's packages, for the `slurm` nox session.
+#   .ci/slurm_cluster.sh [start]   install (if needed), configure, start munged/slurmctld/slurmd, wait for the node
+#   .ci/slurm_cluster.sh stop      stop the three daemons
+# Runs as root; running it again leaves running daemons alone. No cgroups (containers): linuxproc tracking.
+set -euo pipefail
+
+CONF=/etc/slurm/slurm.conf
+MARK="# written by graspexp .ci/slurm_cluster.sh"
+LOGS=/var/log/slurm
+CTLD_PID=/run/slurmctld.pid
+SLURMD_PID=/run/slurmd.pid
+MUNGE_PID=/run/munge/munged.pid
+
+running() { [[ -s $1 ]] && kill -0 "$(cat "$1")" 2>/dev/null; }
+
+stop() {
+    local pidfile
+    for pidfile in "$SLURMD_PID" "$CTLD_PID" "$MUNGE_PID"; do
+        if running "$pidfile"; then
+            kill "$(cat "$pidfile")"
+            for _ in $(seq 50); do running "$pidfile" || break; sleep 0.2; done
+        fi
+    done
+    echo "slurm_cluster: stopped"
+}
+
+install_packages() {
+    command -v slurmctld >/dev/null && command -v slurmd >/dev/null && command -v sbatch >/dev/null \
+        && command -v munged >/dev/null && return
+    # keep the packages' init scripts from starting daemons before there is a config
+    local policy=/usr/sbin/policy-rc.d created=""
+    if [[ ! -e $policy ]]; then
+        printf '#!/bin/sh\nexit 101\n' >"$policy" && chmod +x "$policy" && created=1
+    fi
+    apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+        munge slurmctld slurmd slurm-client >/dev/null
+    [[ -n $created ]] && rm -f "$policy"
+    return 0
+}
+
+write_config() {
+    if [[ -e $CONF ]] && ! grep -qF "$MARK" "$CONF"; then
+        echo "slurm_cluster: $CONF exists and is not ours; not overwriting it" >&2
+        exit 1
+    fi
+    local host node
+    host=$(hostname -s)
+    # "NodeName=<host> CPUs=.. Boards=.. SocketsPerBoard=.. CoresPerSocket=.. ThreadsPerCore=.. RealMemory=.."
+    node=$(slurmd -C | head -n 1)
+    mkdir -p /etc/slurm "$LOGS" /var/spool/slurmctld /var/spool/slurmd
+    cat >"$CONF.new" <<EOF
+$MARK
+ClusterName=graspexp
+SlurmctldHost=$host(127.0.0.1)
+SlurmUser=root
+AuthType=auth/munge
+MpiDefault=none
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+JobAcctGatherType=jobacct_gather/none
+AccountingStorageType=accounting_storage/none
+SelectType=select/cons_tres
+SelectTypeParameters=CR_Core
+ReturnToService=2
+StateSaveLocation=/var/spool/slurmctld
+SlurmdSpoolDir=/var/spool/slurmd
+SlurmctldPidFile=$CTLD_PID
+SlurmdPidFile=$SLURMD_PID
+SlurmctldLogFile=$LOGS/slurmctld.log
+SlurmdLogFile=$LOGS/slurmd.log
+$node NodeAddr=127.0.0.1 State=UNKNOWN
+PartitionName=debug Nodes=$host Default=YES MaxTime=INFINITE State=UP
+EOF
+    mv "$CONF.new" "$CONF"
+}
+
+start_munge() {
+    running "$MUNGE_PID" && return
+    [[ -s /etc/munge/munge.key ]] || mungekey --create --keyfile=/etc/munge/munge.key
+    chown munge:munge /etc/munge/munge.key && chmod 0400 /etc/munge/munge.key
+    install -d -o munge -g munge -m 0755 /run/munge
+    install -d -o munge -g munge -m 0700 /var/lib/munge /var/log/munge
+    runuser -u munge -- munged
+}
+
+start() {
+    install_packages
+    write_config
+    start_munge
+    running "$CTLD_PID" || slurmctld
+    running "$SLURMD_PID" || slurmd
+    local host state
+    host=$(hostname -s)
+    for _ in $(seq 150); do
+        state=$(sinfo -h -n "$host" -o %T 2>/dev/null || true)
+        if [[ $state == idle* || $state == mixed* || $state == allocated* ]]; then
+            echo "slurm_cluster: node $host $state"
+            return
+        fi
+        sleep 0.2
+    done
+    echo "slurm_cluster: node $host not up (state '${state:-?}'); see $LOGS/" >&2
+    tail -n 20 "$LOGS/slurmctld.log" "$LOGS/slurmd.log" >&2 || true
+    exit 1
+}
+
+case "${1:-start}" in
+    start) start ;;
+    stop) stop ;;
+    *) echo "usage: $0 [start|stop]" >&2; exit 2 ;;
+esac
