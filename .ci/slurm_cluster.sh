@@ -1,22 +1,27 @@
 #!/usr/bin/env bash
 # A one-node SLURM cluster on this host from Debian 12's packages, for the `slurm` nox session.
-#   .ci/slurm_cluster.sh [start]   install (if needed), configure, start munged/slurmctld/slurmd, wait for the node
-#   .ci/slurm_cluster.sh stop      stop the three daemons
+#   .ci/slurm_cluster.sh [start]   install (if needed), configure, start munged, mariadbd, slurmdbd, slurmctld, slurmd, wait for the node
+#   .ci/slurm_cluster.sh stop      stop the daemons
 # Runs as root; running it again leaves running daemons alone. No cgroups (containers): linuxproc tracking.
+# Accounting (slurmdbd on MariaDB) is not optional: submitit learns that a task was cancelled or died
+# only from sacct; without it the submitting process waits forever for that task's result.
 set -euo pipefail
 
 CONF=/etc/slurm/slurm.conf
+DBD_CONF=/etc/slurm/slurmdbd.conf
 MARK="# written by graspexp .ci/slurm_cluster.sh"
 LOGS=/var/log/slurm
 CTLD_PID=/run/slurmctld.pid
 SLURMD_PID=/run/slurmd.pid
 MUNGE_PID=/run/munge/munged.pid
+DB_PID=/run/mysqld/mysqld.pid
+DBD_PID=/run/slurmdbd.pid
 
 running() { [[ -s $1 ]] && kill -0 "$(cat "$1")" 2>/dev/null; }
 
 stop() {
     local pidfile
-    for pidfile in "$SLURMD_PID" "$CTLD_PID" "$MUNGE_PID"; do
+    for pidfile in "$SLURMD_PID" "$CTLD_PID" "$DBD_PID" "$DB_PID" "$MUNGE_PID"; do
         if running "$pidfile"; then
             kill "$(cat "$pidfile")"
             for _ in $(seq 50); do running "$pidfile" || break; sleep 0.2; done
@@ -26,8 +31,11 @@ stop() {
 }
 
 install_packages() {
-    command -v slurmctld >/dev/null && command -v slurmd >/dev/null && command -v sbatch >/dev/null \
-        && command -v munged >/dev/null && return
+    local bin missing=""
+    for bin in munged mariadbd slurmdbd slurmctld slurmd sbatch sacct; do
+        command -v "$bin" >/dev/null || missing=1
+    done
+    [[ -z $missing ]] && return
     # keep the packages' init scripts from starting daemons before there is a config
     local policy=/usr/sbin/policy-rc.d created=""
     if [[ ! -e $policy ]]; then
@@ -35,16 +43,19 @@ install_packages() {
     fi
     apt-get update -qq
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
-        munge slurmctld slurmd slurm-client >/dev/null
+        munge mariadb-server slurmdbd slurmctld slurmd slurm-client >/dev/null
     [[ -n $created ]] && rm -f "$policy"
     return 0
 }
 
 write_config() {
-    if [[ -e $CONF ]] && ! grep -qF "$MARK" "$CONF"; then
-        echo "slurm_cluster: $CONF exists and is not ours; not overwriting it" >&2
-        exit 1
-    fi
+    local f
+    for f in "$CONF" "$DBD_CONF"; do
+        if [[ -e $f ]] && ! grep -qF "$MARK" "$f"; then
+            echo "slurm_cluster: $f exists and is not ours; not overwriting it" >&2
+            exit 1
+        fi
+    done
     local host node
     host=$(hostname -s)
     # "NodeName=<host> CPUs=.. Boards=.. SocketsPerBoard=.. CoresPerSocket=.. ThreadsPerCore=.. RealMemory=.."
@@ -60,7 +71,8 @@ MpiDefault=none
 ProctrackType=proctrack/linuxproc
 TaskPlugin=task/none
 JobAcctGatherType=jobacct_gather/none
-AccountingStorageType=accounting_storage/none
+AccountingStorageType=accounting_storage/slurmdbd
+AccountingStorageHost=localhost
 SelectType=select/cons_tres
 SelectTypeParameters=CR_Core
 ReturnToService=2
@@ -74,6 +86,35 @@ $node NodeAddr=127.0.0.1 State=UNKNOWN
 PartitionName=debug Nodes=$host Default=YES MaxTime=INFINITE State=UP
 EOF
     mv "$CONF.new" "$CONF"
+    # root reaches MariaDB through its unix socket (Debian's root@localhost uses unix_socket auth)
+    (umask 077 && cat >"$DBD_CONF" <<EOF
+$MARK
+AuthType=auth/munge
+DbdHost=localhost
+SlurmUser=root
+StorageType=accounting_storage/mysql
+StorageUser=root
+StorageLoc=slurm_acct_db
+LogFile=$LOGS/slurmdbd.log
+PidFile=$DBD_PID
+EOF
+    )
+}
+
+start_db() {
+    running "$DB_PID" && return
+    install -d -o mysql -g mysql -m 0755 /run/mysqld
+    [[ -d /var/lib/mysql/mysql ]] || mariadb-install-db --user=mysql >/dev/null
+    setsid runuser -u mysql -- mariadbd >"$LOGS/mariadb.log" 2>&1 </dev/null &
+    for _ in $(seq 150); do mariadb-admin ping >/dev/null 2>&1 && return; sleep 0.2; done
+    echo "slurm_cluster: MariaDB did not start; see $LOGS/mariadb.log" >&2
+    exit 1
+}
+
+start_dbd() {
+    running "$DBD_PID" || slurmdbd
+    for _ in $(seq 150); do sacctmgr -n list cluster >/dev/null 2>&1 && break; sleep 0.2; done
+    sacctmgr -n -P list cluster format=cluster | grep -qx graspexp || sacctmgr -i add cluster graspexp >/dev/null
 }
 
 start_munge() {
@@ -89,6 +130,8 @@ start() {
     install_packages
     write_config
     start_munge
+    start_db
+    start_dbd
     running "$CTLD_PID" || slurmctld
     running "$SLURMD_PID" || slurmd
     local host state
