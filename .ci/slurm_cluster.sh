@@ -60,6 +60,7 @@ write_config() {
     host=$(hostname -s)
     # "NodeName=<host> CPUs=.. Boards=.. SocketsPerBoard=.. CoresPerSocket=.. ThreadsPerCore=.. RealMemory=.."
     node=$(slurmd -C | head -n 1)
+    # KillWait: scancel's SIGTERM is ignored by submitit's jobs; SIGKILL follows after this many seconds
     mkdir -p /etc/slurm "$LOGS" /var/spool/slurmctld /var/spool/slurmd
     cat >"$CONF.new" <<EOF
 $MARK
@@ -76,6 +77,7 @@ AccountingStorageHost=localhost
 SelectType=select/cons_tres
 SelectTypeParameters=CR_Core
 ReturnToService=2
+KillWait=1
 StateSaveLocation=/var/spool/slurmctld
 SlurmdSpoolDir=/var/spool/slurmd
 SlurmctldPidFile=$CTLD_PID
@@ -132,7 +134,11 @@ start() {
     start_munge
     start_db
     start_dbd
-    running "$CTLD_PID" || slurmctld
+    if running "$CTLD_PID"; then
+        scontrol reconfigure  # a config written by a newer version of this script
+    else
+        slurmctld
+    fi
     running "$SLURMD_PID" || slurmd
     local host state
     host=$(hostname -s)
