@@ -20,12 +20,12 @@ DBD_PID=/run/slurmdbd.pid
 running() { [[ -s $1 ]] && kill -0 "$(cat "$1")" 2>/dev/null; }
 
 stop() {
-    local pidfile
+    local pidfile pid
     for pidfile in "$SLURMD_PID" "$CTLD_PID" "$DBD_PID" "$DB_PID" "$MUNGE_PID"; do
-        if running "$pidfile"; then
-            kill "$(cat "$pidfile")"
-            for _ in $(seq 50); do running "$pidfile" || break; sleep 0.2; done
-        fi
+        pid=$(cat "$pidfile" 2>/dev/null) || continue
+        kill "$pid" 2>/dev/null || continue
+        # by pid, not pid file: a daemon removes its file before it has finished shutting down
+        for _ in $(seq 100); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
     done
     echo "slurm_cluster: stopped"
 }
