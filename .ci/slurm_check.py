@@ -26,8 +26,8 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 NAME = "graspexp-slurm-check"
-SWEEP = ["mode=collab,bin", "rot=z", "dataset=primitives", "objects=[can,box]", "trials=20", "progress=false"]
-N_TRIALS_PER_JOB = 2 * 20  # objects x trials
+SWEEP = ["mode=collab,bin", "rot=z", "dataset=primitives", "objects=[can,box]", "trials=40", "progress=false"]
+N_TRIALS_PER_JOB = 2 * 40  # objects x trials: enough that the task outlives the ~3 s scancel takes to kill it
 SLURM = [
     "hydra/launcher=submitit_slurm",
     "hydra.launcher.partition=debug",
@@ -36,7 +36,7 @@ SLURM = [
     "hydra.launcher.cpus_per_task=1",
 ]
 CANCELLED_TASK = 1  # array task i runs Hydra job i: mode=collab is 0, mode=bin is 1
-CANCELLED_DIR = "dataset=primitives,mode=bin,objects=[can,box],rot=z,trials=20"
+CANCELLED_DIR = "dataset=primitives,mode=bin,objects=[can,box],rot=z,trials=40"
 # sbatch exports the submitting environment: the jobs run this checkout with the same interpreter and data
 ENV = {
     **os.environ,
