@@ -15,15 +15,16 @@ def _cluster_answers() -> bool:
     if not shutil.which("sbatch") or not shutil.which("sinfo"):
         return False
     try:
-        proc = subprocess.run(["sinfo", "-h", "-p", "debug"], capture_output=True, timeout=10)
+        proc = subprocess.run(["sinfo", "-h", "-p", "debug"], capture_output=True, timeout=15)
     except subprocess.TimeoutExpired:
         return False
     return proc.returncode == 0
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(not _cluster_answers(), reason="no SLURM cluster with a partition 'debug'")
 def test_cancelled_and_resubmitted_slurm_sweep_equals_an_uninterrupted_one(tmp_path: Path) -> None:
+    if not _cluster_answers():  # asked here, not at collection: sinfo waits for a controller that is down
+        pytest.skip("no SLURM cluster with a partition 'debug'")
     proc = subprocess.run(
         [sys.executable, str(REPO / ".ci" / "slurm_check.py"), str(tmp_path / "check")],
         cwd=REPO,
