@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # A one-node SLURM cluster on this host from Debian 12's packages, for the `slurm` nox session.
-#   .ci/slurm_cluster.sh [start]   install (if needed), configure, start munged, mariadbd, slurmdbd, slurmctld, slurmd, wait for the node
+#   .ci/slurm_cluster.sh [start]   install (if needed), configure, start munged, mariadbd, slurmdbd,
+#                                  slurmctld and slurmd, wait until the node is idle
 #   .ci/slurm_cluster.sh stop      stop the daemons
 # Runs as root; running it again leaves running daemons alone. No cgroups (containers): linuxproc tracking.
 # Accounting (slurmdbd on MariaDB) is not optional: submitit learns that a task was cancelled or died
@@ -37,15 +38,13 @@ install_packages() {
     done
     [[ -z $missing ]] && return
     # keep the packages' init scripts from starting daemons before there is a config
-    local policy=/usr/sbin/policy-rc.d created=""
-    if [[ ! -e $policy ]]; then
-        printf '#!/bin/sh\nexit 101\n' >"$policy" && chmod +x "$policy" && created=1
+    if [[ ! -e /usr/sbin/policy-rc.d ]]; then
+        printf '#!/bin/sh\nexit 101\n' >/usr/sbin/policy-rc.d && chmod +x /usr/sbin/policy-rc.d
+        trap 'rm -f /usr/sbin/policy-rc.d' EXIT
     fi
     apt-get update -qq
     DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
         munge mariadb-server slurmdbd slurmctld slurmd slurm-client >/dev/null
-    [[ -n $created ]] && rm -f "$policy"
-    return 0
 }
 
 write_config() {
@@ -60,8 +59,8 @@ write_config() {
     host=$(hostname -s)
     # "NodeName=<host> CPUs=.. Boards=.. SocketsPerBoard=.. CoresPerSocket=.. ThreadsPerCore=.. RealMemory=.."
     node=$(slurmd -C | head -n 1)
-    # KillWait: scancel's SIGTERM is ignored by submitit's jobs; SIGKILL follows after this many seconds
     mkdir -p /etc/slurm "$LOGS" /var/spool/slurmctld /var/spool/slurmd
+    # KillWait: submitit's jobs ignore scancel's SIGTERM; SIGKILL comes this many seconds later (default 30)
     cat >"$CONF.new" <<EOF
 $MARK
 ClusterName=graspexp
