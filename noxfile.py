@@ -1,5 +1,5 @@
 """Sessions CI and developers call: ``nox -s tests``, ``nox -s lint``, ``nox -s docs``, ``nox -s bench``,
-``nox -s reproduce``."""
+``nox -s reproduce``, ``nox -s slurm``."""
 
 import os
 import time
@@ -110,3 +110,20 @@ def readings(session: nox.Session) -> None:
     start = time.perf_counter()
     session.run("python", "-m", "graspexp", "readings", *session.posargs, env=ENV, external=True)
     session.log(f"readings: {time.perf_counter() - start:.0f} s wall")
+
+
+@nox.session(venv_backend="none")
+def slurm(session: nox.Session) -> None:
+    """A sweep on a real one-node SLURM cluster: ``.ci/slurm_cluster.sh`` installs (Debian 12, as root)
+    and starts munged, MariaDB, slurmdbd, slurmctld and slurmd; a small sweep runs with
+    ``hydra/launcher=submitit_slurm``, one array task is cancelled mid-run with ``scancel``, the same command
+    is re-submitted into the same sweep dir, and ``bench.compare_runs`` must find every trial identical to
+    an uninterrupted joblib sweep; then the cluster is stopped. Non-zero exit on any difference.
+
+    Runs in the environment nox is started from (activate the project venv first). ``nox -s slurm -- DIR``
+    writes into DIR (default outputs/slurm_check, emptied first). The logic is ``.ci/slurm_check.py``
+    (``python .ci/slurm_check.py --cluster [DIR]`` without nox; without ``--cluster`` on a running cluster).
+    """
+    start = time.perf_counter()
+    session.run("python", ".ci/slurm_check.py", "--cluster", *session.posargs, env=ENV, external=True)
+    session.log(f"slurm: {time.perf_counter() - start:.0f} s wall")
