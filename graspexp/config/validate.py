@@ -103,7 +103,19 @@ def _check_relations(cfg: DictConfig) -> None:
             raise ConfigError(f"{left}={a!r} is invalid: expected {op} {right}={b!r}")
 
 
+def _check_split(cfg: DictConfig) -> None:
+    """A split and an explicit object list both choose the objects: refused, not silently merged."""
+    split = OmegaConf.select(cfg, "dataset.split")
+    for key in ("objects", "dataset.objects"):
+        if split is not None and OmegaConf.select(cfg, key):
+            raise ConfigError(
+                f"dataset.split={split!r} is invalid together with {key}=[...]: both choose the objects; "
+                "give one of them"
+            )
+
+
 def validate(cfg: DictConfig | Any) -> None:
     """Raise :class:`ConfigError` naming the first dotted key whose value is unknown, missing or invalid."""
     _check_node(cfg, job.JobConfig, "")
     _check_relations(cfg)
+    _check_split(cfg)

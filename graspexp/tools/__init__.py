@@ -12,6 +12,7 @@ TOOLS: tuple[str, ...] = (
     "download",
     "prepare",
     "area",
+    "tune",
     "bench.trials",
     "bench.plan_latency",
     "bench.collision_shapes",

@@ -110,7 +110,7 @@ def _groups_epilog() -> str:
         for g in ("dataset", "mode", "rot", "gripper", "planner", "cost", "sim")
     ]
     lines.append(
-        "top-level keys: trials, seed, objects, record, live, live_port, progress, perception.noise.*"
+        "top-level keys: trials, seed, objects, record, live, live_port, progress, objective, perception.noise.*"
     )
     lines.append(f"tools (python -m graspexp TOOL --help): {', '.join(TOOLS)}")
     lines.append(
