@@ -66,7 +66,8 @@ class OptunaStudy(Callback):
         keys = searched_keys(overrides)
         trials = study.get_trials(deepcopy=False)
         if not trials:
-            baseline = {k: OmegaConf.select(config, k) for k in keys}
+            choices = config.hydra.runtime.choices  # a searched config group: its default option
+            baseline = {k: choices[k] if k in choices else OmegaConf.select(config, k) for k in keys}
             study.enqueue_trial(baseline)
             log.info("study %s: trial 0 scores the config's own values %s", study.study_name, baseline)
         for t in trials:
