@@ -30,6 +30,8 @@ class ScoredSet:
     """One row per trial (the job's ``results.csv``): ``object``, ``trial``, ``success``, ..."""
     run_dir: Path
     wall_s: float
+    trial: int | None = None
+    """The study trial these parameters come from; None for the baseline (the config's values)."""
 
 
 def _rate(df: pd.DataFrame) -> str:
@@ -49,15 +51,18 @@ def paired_test(a: pd.DataFrame, b: pd.DataFrame) -> tuple[int, int, float]:
     return only_a, only_b, float(p)
 
 
-def _search_lines(sweep: SweepStudy, best: dict[str, object], base: dict[str, object]) -> list[str]:
+def _search_lines(sweep: SweepStudy, scored: list[ScoredSet]) -> list[str]:
     dists = sweep.study.best_trial.distributions
-    lines = ["| parameter | searched | baseline | best |", "|---|---|---|---|"]
+    base, cand = scored[0], scored[-1]
+    lines = [f"| parameter | searched | {base.label} | {cand.label} |", "|---|---|---|---|"]
     for key in sweep.searched:
         d = dists.get(key)
         low, high = getattr(d, "low", None), getattr(d, "high", None)
         scale = " log" if getattr(d, "log", False) or type(d).__name__.startswith("LogUniform") else ""
         rng = f"[{low:g}, {high:g}]{scale}" if low is not None else str(getattr(d, "choices", ""))
-        lines.append(f"| `{key}` | {rng} | {base.get(key)} | {best.get(key, float('nan')):.4g} |")
+        lines.append(
+            f"| `{key}` | {rng} | {base.params.get(key)} | {cand.params.get(key, float('nan')):.4g} |"
+        )
     return lines
 
 
@@ -84,9 +89,11 @@ def tuning_markdown(sweep: SweepStudy, scored: list[ScoredSet], command: str, pn
         f"- Fixed overrides: `{' '.join(fixed)}`.",
         f"- Objective on the training objects: baseline (trial 0, the config's values) {trial0:.4f}; best "
         f"{best.value:.4f} (trial {best.number}; {ties} complete trial(s) reach that value, the first is "
-        "taken).",
+        "the best)." + ("" if best.number else " No trial beat the baseline on the training objects."),
+        f"- Scored below as `{tuned.label}`: trial {tuned.trial}, objective on the training objects "
+        f"{study.trials[tuned.trial].value:.4f}.",
         "",
-        *_search_lines(sweep, best.params, baseline.params),
+        *_search_lines(sweep, scored),
         "",
         "## Held-out objects",
         "",

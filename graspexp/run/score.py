@@ -31,20 +31,29 @@ def score_overrides(sweep: SweepStudy, split: str, trials: int, extra: Sequence[
 
 
 def score_study(
-    sweep: SweepStudy, sweep_dir: Path, split: str, trials: int, extra: Sequence[str] = ()
+    sweep: SweepStudy,
+    sweep_dir: Path,
+    split: str,
+    trials: int,
+    extra: Sequence[str] = (),
+    candidate: int | None = None,
 ) -> list[ScoredSet]:
-    """Run the baseline and the study's best trial on ``split`` (``trials`` per object); returns both, the
-    baseline first. Raises :class:`graspexp.config.ConfigError` for a bad override."""
+    """Run the baseline and the study's trial ``candidate`` (None: its best trial) on ``split``
+    (``trials`` per object); returns both, the baseline first. Raises
+    :class:`graspexp.config.ConfigError` for a bad override."""
     base = score_overrides(sweep, split, trials, extra)
     cfg = compose_validated(base)
     baseline = {k: OmegaConf.select(cfg, k) for k in sweep.searched}
     label = "paper" if not any(o.startswith("cost=") for o in base) else "baseline"
     out = []
-    for name, params in ((label, baseline), ("tuned", dict(sweep.study.best_trial.params))):
+    best = sweep.study.best_trial
+    chosen = best if candidate is None else sweep.study.trials[candidate]
+    tuned = "tuned" if chosen.number == best.number else f"trial {chosen.number}"
+    for name, params, number in ((label, baseline, None), (tuned, dict(chosen.params), chosen.number)):
         job = compose_validated([*base, *(f"{k}={v!r}" for k, v in params.items())])
-        run_dir = sweep_dir / "score" / f"{split}_{name}"
+        run_dir = sweep_dir / "score" / f"{split}_{name.replace(' ', '')}"
         t0 = time.perf_counter()
         run_in_dir(job, run_dir)
         results = pd.read_csv(run_dir / "results.csv")
-        out.append(ScoredSet(name, params, results, run_dir, time.perf_counter() - t0))
+        out.append(ScoredSet(name, params, results, run_dir, time.perf_counter() - t0, number))
     return out

@@ -41,6 +41,12 @@ from graspexp.report.study import (
 log = logging.getLogger(__name__)
 
 
+def _directions(direction: Any) -> list[str]:
+    """The sweeper's ``direction`` (a name, its Enum, or a list of either) as Optuna's direction names."""
+    items = list(direction) if OmegaConf.is_list(direction) or isinstance(direction, list) else [direction]
+    return [str(getattr(d, "name", d)) for d in items]
+
+
 class OptunaStudy(Callback):
     """Resume an Optuna study stored with its sweep, baseline first; save its history and plots at the end."""
 
@@ -58,7 +64,7 @@ class OptunaStudy(Callback):
         study = optuna.create_study(
             study_name=sweeper.study_name,
             storage=str(storage),
-            directions=list(sweeper.get("directions") or [sweeper.direction]),
+            directions=_directions(sweeper.direction),
             load_if_exists=True,
         )
         overrides = [str(o) for o in config.hydra.overrides.task]
