@@ -39,6 +39,8 @@ from graspexp.report.study import (
 )
 
 log = logging.getLogger(__name__)
+INTERRUPTED = "graspexp_interrupted"
+"""System attribute of a trial whose process was killed: marked FAIL, run again, not counted as finished."""
 
 
 def _directions(direction: Any) -> list[str]:
@@ -78,10 +80,11 @@ class OptunaStudy(Callback):
             log.info("study %s: trial 0 scores the config's own values %s", study.study_name, baseline)
         for t in trials:
             if t.state == optuna.trial.TrialState.RUNNING:  # its process was killed: run it again
+                study._storage.set_trial_system_attr(t._trial_id, INTERRUPTED, True)
                 study.tell(t.number, state=optuna.trial.TrialState.FAIL)
                 study.enqueue_trial(t.params)
                 log.info("study %s: trial %d was interrupted; it runs again", study.study_name, t.number)
-        finished = sum(t.state.name in FINISHED_STATES for t in trials)
+        finished = sum(t.state.name in FINISHED_STATES and INTERRUPTED not in t.system_attrs for t in trials)
         if finished:
             left = max(0, int(sweeper.n_trials) - finished)
             log.info("study %s resumes: %d trial(s) finished, %d to go", study.study_name, finished, left)
