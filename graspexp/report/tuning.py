@@ -9,6 +9,7 @@ exactly one of the two succeeded.
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -51,6 +52,18 @@ def paired_test(a: pd.DataFrame, b: pd.DataFrame) -> tuple[int, int, float]:
     return only_a, only_b, float(p)
 
 
+def _max_factor(base: dict[str, object], other: dict[str, object]) -> float:
+    """The largest ratio (>= 1) between two sets' positive numeric values of the same key; 1 when none."""
+    ratios = [
+        max(float(v) / float(base[k]), float(base[k]) / float(v))
+        for k, v in other.items()
+        if isinstance(v, int | float)
+        and isinstance(base.get(k), int | float)
+        and float(v) > 0 < float(base[k])
+    ]
+    return max(ratios, default=1.0)
+
+
 def _search_lines(sweep: SweepStudy, scored: list[ScoredSet]) -> list[str]:
     dists = sweep.study.best_trial.distributions
     base, cand = scored[0], scored[-1]
@@ -91,7 +104,11 @@ def tuning_markdown(sweep: SweepStudy, scored: list[ScoredSet], command: str, pn
         f"{best.value:.4f} (trial {best.number}; {ties} complete trial(s) reach that value, the first is "
         "the best)." + ("" if best.number else " No trial beat the baseline on the training objects."),
         f"- Scored below as `{tuned.label}`: trial {tuned.trial}, objective on the training objects "
-        f"{study.trials[tuned.trial].value:.4f}.",
+        f"{study.trials[tuned.trial].value:.4f}; its values differ from the {baseline.label}'s by up to a "
+        f"factor {_max_factor(baseline.params, tuned.params):.3g}.",
+        "- Objective of the complete trials (value: count): "
+        + ", ".join(f"{v:.4f}: {n}" for v, n in sorted(Counter(t.value for t in done).items(), reverse=True))
+        + f"; the study's jobs took {sum(t.duration.total_seconds() for t in done) / 60:.1f} min of wall time.",
         "",
         *_search_lines(sweep, scored),
         "",

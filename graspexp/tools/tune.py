@@ -22,8 +22,8 @@ PROG = "graspexp tune"
 
 def _preset_yaml(params: dict[str, object], source: str) -> str:
     lines = [
-        f"# Eq. (1)-(3) constants tuned by an Optuna study ({source}); scored beside the paper's in",
-        "# docs/results/tuning.md. The paper's constants stay the default (cost=paper).",
+        f"# Eq. (1)-(3) constants from an Optuna study ({source});",
+        "# scored beside the paper's in docs/results/tuning.md. The paper's constants stay the default (cost=paper).",
         "defaults:",
         "  - /schema_cost@_here_",
     ]
@@ -68,8 +68,11 @@ def main(argv: list[str] | None = None) -> int:
     command = " ".join(["python -m graspexp tune", *(argv if argv is not None else sys.argv[2:])])
     (out / "tuning.md").write_text(tuning_markdown(sweep, scored, command, pngs))
     if args.preset is not None:
-        number = args.trial if args.trial is not None else sweep.study.best_trial.number
-        source = f"{args.sweep_dir}, trial {number}"
+        trial, first = scored[-1].trial, sweep.study.trials[0]
+        source = (
+            f"{args.sweep_dir}, trial {trial}: objective {sweep.study.trials[trial].value:.4f} on the training "
+            f"objects, trial 0 (the {scored[0].label}'s values) {first.value:.4f}"
+        )
         args.preset.write_text(_preset_yaml(scored[-1].params, source))
     print((out / "tuning.md").read_text(), end="")
     print(f"\n{PROG}: written to {out}", file=sys.stderr)
