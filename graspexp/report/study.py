@@ -130,7 +130,8 @@ def plot_study(study: optuna.Study, out_dir: Path) -> list[Path]:
     for ax, name in zip(axes.flat, names, strict=False):
         pts = [(t.params[name], t.value, t.number) for t in done if name in t.params]
         x, y, n = (np.array(v) for v in zip(*pts, strict=True))
-        ax.scatter(x, y, c=np.where(n == 0, BASELINE_COLOUR, "#1f77b4"), s=18)
+        ax.scatter(x[n != 0], y[n != 0], s=18)
+        ax.scatter(x[n == 0], y[n == 0], s=40, color=BASELINE_COLOUR, zorder=3)  # on top of ties
         if _is_log(done[-1].distributions.get(name)):
             ax.set_xscale("log")
         ax.set_xlabel(name)
