@@ -41,6 +41,12 @@ def _rate(df: pd.DataFrame) -> str:
     return f"{pct:.1f} % [{lo:.1f}, {hi:.1f}] ({k}/{n})"
 
 
+def _reasons(df: pd.DataFrame) -> str:
+    """Failure reasons with their counts, the most frequent first (``none`` when every trial held)."""
+    counts = df.loc[~df["success"].astype(bool), "reason"].value_counts()
+    return ", ".join(f"{reason} {n}" for reason, n in counts.items()) or "none"
+
+
 def paired_test(a: pd.DataFrame, b: pd.DataFrame) -> tuple[int, int, float]:
     """(trials only ``a`` won, trials only ``b`` won, McNemar's exact two-sided p-value), matching trials
     by (object, trial); p is 1 when no trial differs."""
@@ -130,6 +136,7 @@ def tuning_markdown(sweep: SweepStudy, scored: list[ScoredSet], command: str, pn
         "",
         f"- {tuned.label} minus {baseline.label}: {gain:+.1f} percentage points; trials only {baseline.label} "
         f"won: {only_base}, only {tuned.label} won: {only_tuned}; McNemar exact p = {p:.3g}.",
+        *(f"- Failures of {s.label}: {_reasons(s.results)}." for s in scored),
         f"- Wall time: {', '.join(f'{s.label} {s.wall_s:.0f} s' for s in scored)}; runs in "
         f"{', '.join(f'`{s.run_dir}`' for s in scored)}.",
         "",
