@@ -57,7 +57,7 @@ class JobConfig:
     progress: bool = True
     """Show a progress bar."""
     objective: str = "success"
-    """What the job returns to a sweeper (``hydra/sweeper=optuna`` maximises it), a fraction in [0, 1]:
+    """What the job returns to a sweeper (``hydra/sweeper=study`` maximises it), a fraction in [0, 1]:
     ``success``: the mean over objects of each object's success rate (with equal trials per object, as a
     job runs them, this equals the mean over all trials); ``worst_object``: the lowest object's success
     rate (tunes for the hardest object). A job that cannot run returns None (the study marks it FAIL)."""

@@ -122,6 +122,15 @@ def test_sweep_precheck_expands_optuna_ranges_to_their_ends() -> None:
     assert {c[0] for c in combos} == {"cost.angle_weight=0.01", "cost.angle_weight=1.0"}
 
 
+def test_a_search_range_without_an_optuna_sweeper_is_one_line() -> None:
+    proc = _graspexp("-m", "cost.angle_weight=interval(0.01, 1)", ok=False)
+    assert proc.returncode == 2
+    assert proc.stderr.strip() == (
+        "graspexp: error: cost.angle_weight=interval(0.01, 1) is a search range, which only an Optuna study "
+        "draws from: add hydra/sweeper=study"
+    )
+
+
 def test_split_and_objects_together_are_refused() -> None:
     proc = _graspexp("dataset.split=train", "objects=[can]", ok=False)
     assert proc.returncode == 2
