@@ -99,15 +99,15 @@ def read_sweep_study(sweep_dir: Path) -> SweepStudy:
 
 
 def study_table(study: optuna.Study) -> pd.DataFrame:
-    """One row per trial: ``number``, ``state``, ``value`` (NaN unless COMPLETE), one column per parameter
-    (its override key), ``duration_s`` (wall seconds, NaN while running)."""
+    """One row per trial: ``number``, ``state``, ``value`` (NaN unless COMPLETE; ``value_0``, ``value_1``,
+    ... for several objectives), one column per parameter (its override key), ``duration_s`` (wall
+    seconds, NaN while running)."""
     rows = []
     for t in study.get_trials(deepcopy=False):
         duration = t.duration.total_seconds() if t.duration is not None else np.nan
-        value = t.value if t.state.name == "COMPLETE" else np.nan
-        rows.append(
-            {"number": t.number, "state": t.state.name, "value": value, **t.params, "duration_s": duration}
-        )
+        values = t.values if t.state.name == "COMPLETE" and t.values else [np.nan] * len(study.directions)
+        named = {"value": values[0]} if len(values) == 1 else {f"value_{i}": v for i, v in enumerate(values)}
+        rows.append({"number": t.number, "state": t.state.name, **named, **t.params, "duration_s": duration})
     return pd.DataFrame(rows)
 
 
@@ -118,9 +118,10 @@ def _is_log(distribution: object) -> bool:
 def plot_study(study: optuna.Study, out_dir: Path) -> list[Path]:
     """Write :data:`PARAMS_PNG` (the objective against each parameter; trial 0, the config's own values,
     in red; log axes where the search was on a log scale) and :data:`HISTORY_PNG` (the objective per trial
-    and the best so far) into ``out_dir``; returns their paths (none when no trial completed)."""
+    and the best so far) into ``out_dir``; returns their paths (none when no trial completed or the study
+    has several objectives)."""
     done = [t for t in study.get_trials(deepcopy=False) if t.state.name == "COMPLETE"]
-    if not done:
+    if not done or len(study.directions) > 1:  # the plots show one objective
         return []
     out_dir.mkdir(parents=True, exist_ok=True)
     names = list(dict.fromkeys(k for t in done for k in t.params))

@@ -51,15 +51,22 @@ def main(argv: list[str] | None = None) -> int:
     done = [t.number for t in sweep.study.get_trials(deepcopy=False) if t.state.name == "COMPLETE"]
     if not done:
         fail(f"no trial of the study in {args.sweep_dir} completed", PROG)
+    if len(sweep.study.directions) > 1:
+        fail(
+            f"the study in {args.sweep_dir} has several objectives; tune scores single-objective studies",
+            PROG,
+        )
     if args.trial is not None and args.trial not in done:
         fail(f"--trial {args.trial} is not a complete trial of the study (complete: {done})", PROG)
+    from graspexp.datasets import DatasetError
     from graspexp.report.study import plot_study
     from graspexp.report.tuning import tuning_markdown
+    from graspexp.run.runner import RunError
     from graspexp.run.score import score_study
 
     try:
         scored = score_study(sweep, args.sweep_dir, args.split, args.trials, args.overrides, args.trial)
-    except ConfigError as exc:
+    except (ConfigError, DatasetError, RunError) as exc:  # a bad override, missing data, a locked directory
         fail(str(exc), PROG)
     out = args.out if args.out is not None else args.sweep_dir / "score"
     out.mkdir(parents=True, exist_ok=True)
