@@ -111,7 +111,8 @@ def study_table(study: optuna.Study) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _is_log(distribution: object) -> bool:
+def is_log_scale(distribution: object) -> bool:
+    """Whether an Optuna distribution was searched on a log scale (``tag(log, interval(...))``)."""
     return bool(getattr(distribution, "log", False)) or type(distribution).__name__.startswith("LogUniform")
 
 
@@ -133,7 +134,7 @@ def plot_study(study: optuna.Study, out_dir: Path) -> list[Path]:
         x, y, n = (np.array(v) for v in zip(*pts, strict=True))
         ax.scatter(x[n != 0], y[n != 0], s=18)
         ax.scatter(x[n == 0], y[n == 0], s=40, color=BASELINE_COLOUR, zorder=3)  # on top of ties
-        if _is_log(done[-1].distributions.get(name)):
+        if is_log_scale(done[-1].distributions.get(name)):
             ax.set_xscale("log")
         ax.set_xlabel(name)
     for ax in axes.flat[len(names) :]:

@@ -16,8 +16,9 @@ from pathlib import Path
 import pandas as pd
 from scipy.stats import binomtest
 
+from graspexp.config.job import JobConfig
 from graspexp.report.stats import success_pct
-from graspexp.report.study import SweepStudy
+from graspexp.report.study import SweepStudy, is_log_scale
 
 
 @dataclass(frozen=True)
@@ -33,6 +34,13 @@ class ScoredSet:
     wall_s: float
     trial: int | None = None
     """The study trial these parameters come from; None for the baseline (the config's values)."""
+
+
+OBJECTIVE_WORDS = {
+    "success": "the mean over objects of each object's success rate",
+    "worst_object": "the lowest object's success rate",
+}
+"""Each ``objective`` (:data:`graspexp.config.job.OBJECTIVES`) in words, for the report."""
 
 
 def _rate(df: pd.DataFrame) -> str:
@@ -77,7 +85,7 @@ def _search_lines(sweep: SweepStudy, scored: list[ScoredSet]) -> list[str]:
     for key in sweep.searched:
         d = dists.get(key)
         low, high = getattr(d, "low", None), getattr(d, "high", None)
-        scale = " log" if getattr(d, "log", False) or type(d).__name__.startswith("LogUniform") else ""
+        scale = " log" if is_log_scale(d) else ""
         rng = f"[{low:g}, {high:g}]{scale}" if low is not None else str(getattr(d, "choices", ""))
         lines.append(
             f"| `{key}` | {rng} | {base.params.get(key)} | {cand.params.get(key, float('nan')):.4g} |"
@@ -95,6 +103,7 @@ def tuning_markdown(sweep: SweepStudy, scored: list[ScoredSet], command: str, pn
     ties = sum(t.value == best.value for t in done)
     baseline, tuned = scored[0], scored[-1]
     fixed = [o for o in sweep.task_overrides if o.split("=", 1)[0] not in sweep.searched]
+    objective = next((o.split("=", 1)[1] for o in fixed if o.startswith("objective=")), JobConfig.objective)
     trial0 = trials[0].value if trials and trials[0].state.name == "COMPLETE" else float("nan")
     out = [
         "# Tuning the paper's constants: study and held-out score",
@@ -105,7 +114,7 @@ def tuning_markdown(sweep: SweepStudy, scored: list[ScoredSet], command: str, pn
         "",
         f"- Storage `{sweep.storage}`, study `{study.study_name}`: {len(trials)} trials, {len(done)} complete, "
         f"{sum(t.state.name == 'FAIL' for t in trials)} failed; direction {study.direction.name.lower()}.",
-        f"- Fixed overrides: `{' '.join(fixed)}`.",
+        f"- Fixed overrides: `{' '.join(fixed)}`; objective `{objective}` ({OBJECTIVE_WORDS[objective]}).",
         f"- Objective on the training objects: baseline (trial 0, the config's values) {trial0:.4f}; best "
         f"{best.value:.4f} (trial {best.number}; {ties} complete trial(s) reach that value, the first is "
         "the best)." + ("" if best.number else " No trial beat the baseline on the training objects."),

@@ -16,7 +16,9 @@ import pytest
 import yaml
 
 from graspexp.config.compose import expand_sweeps
+from graspexp.config.job import OBJECTIVES
 from graspexp.report.study import read_sweep_study
+from graspexp.report.tuning import OBJECTIVE_WORDS
 
 REPO = Path(__file__).resolve().parents[2]
 STUDY = [
@@ -112,6 +114,10 @@ def test_a_job_that_cannot_run_is_a_failed_trial_and_the_study_goes_on(tmp_path:
     states = [t.state.name for t in read_sweep_study(out).study.get_trials()]
     assert states == ["COMPLETE", "COMPLETE", "FAIL", "COMPLETE"]
     assert len(pd.read_csv(out / "optuna_trials.csv")) == 4
+
+
+def test_every_objective_is_described_in_the_report() -> None:
+    assert set(OBJECTIVE_WORDS) == set(OBJECTIVES)
 
 
 def test_sweep_precheck_expands_optuna_ranges_to_their_ends() -> None:
