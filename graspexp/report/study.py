@@ -83,6 +83,12 @@ def write_study_record(sweep_dir: Path, storage: str, study_name: str, task_over
     OmegaConf.save(OmegaConf.create(record), sweep_dir / STUDY_YAML)
 
 
+def recorded_overrides(sweep_dir: Path) -> list[str] | None:
+    """The overrides of the study recorded in ``sweep_dir`` (:data:`STUDY_YAML`); None when there is none."""
+    path = sweep_dir / STUDY_YAML
+    return [str(o) for o in OmegaConf.load(path).task_overrides] if path.is_file() else None
+
+
 def read_sweep_study(sweep_dir: Path) -> SweepStudy:
     """The study of the sweep in ``sweep_dir`` (its :data:`STUDY_YAML`; an SQLite file of that name in
     ``sweep_dir`` is used wherever the study ran from); ValueError (one line) when there is none."""

@@ -8,6 +8,7 @@ the sweeper has a ``storage``:
   study's storage and command there (:data:`graspexp.report.study.STUDY_YAML`) and, for a new
   study, enqueues the config's own values of the searched keys as trial 0 (the paper's constants are
   scored under the same conditions as every candidate);
+- a sweep directory holding a study of other overrides (``hydra.*`` aside) is refused in one line;
 - for a study that already has trials (the same command run again after a kill), it marks the trials left
   ``RUNNING`` as FAIL and enqueues their parameters again (with ``record=true`` their job directory, named
   by the same overrides, resumes from its logs), and runs only what is missing to reach
@@ -21,6 +22,7 @@ the sweeper has a ``storage``:
 from __future__ import annotations
 
 import logging
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -32,6 +34,7 @@ from graspexp.report.study import (
     TRIALS_CSV,
     load_study,
     plot_study,
+    recorded_overrides,
     searched_keys,
     sqlite_path,
     study_table,
@@ -41,6 +44,11 @@ from graspexp.report.study import (
 log = logging.getLogger(__name__)
 INTERRUPTED = "graspexp_interrupted"
 """System attribute of a trial whose process was killed: marked FAIL, run again, not counted as finished."""
+
+
+def _as_dict(overrides: list[str]) -> dict[str, str]:
+    """key -> value of command-line overrides, the last of a repeated key winning (as in Hydra)."""
+    return {k: v for k, _, v in (o.partition("=") for o in overrides)}
 
 
 def _directions(direction: Any) -> list[str]:
@@ -57,6 +65,23 @@ class OptunaStudy(Callback):
         storage = OmegaConf.select(sweeper, "storage", default=None)
         if not storage:
             return
+        overrides = [str(o) for o in config.hydra.overrides.task]
+        recorded = recorded_overrides(Path(config.hydra.sweep.dir))
+        if recorded is not None:
+            old, new = _as_dict(recorded), _as_dict(overrides)
+            changed = [
+                f"{k}: {old.get(k, '<absent>')} in the study, {new.get(k, '<absent>')} now"
+                for k in sorted(old.keys() | new.keys())
+                if old.get(k) != new.get(k)
+            ]
+            if changed:
+                print(
+                    f"graspexp: error: {config.hydra.sweep.dir} holds a study of another command ("
+                    f"{'; '.join(changed)}); a study resumes only with the same overrides: use another "
+                    "hydra.sweep.dir",
+                    file=sys.stderr,
+                )
+                raise SystemExit(2)
         db = sqlite_path(str(storage))
         Path(config.hydra.sweep.dir).mkdir(parents=True, exist_ok=True)
         if db is not None:
@@ -69,7 +94,6 @@ class OptunaStudy(Callback):
             directions=_directions(sweeper.direction),
             load_if_exists=True,
         )
-        overrides = [str(o) for o in config.hydra.overrides.task]
         write_study_record(Path(config.hydra.sweep.dir), str(storage), str(sweeper.study_name), overrides)
         keys = searched_keys(overrides)
         trials = study.get_trials(deepcopy=False)

@@ -87,6 +87,9 @@ def test_study_resumes_to_n_trials_in_all(study_dir: Path) -> None:
     assert trials[3].params["cost.angle_weight"] not in before  # the sampler does not repeat the first run
     _graspexp("-m", *STUDY, "hydra.sweeper.n_trials=4", f"hydra.sweep.dir={study_dir}")  # done: runs none
     assert len(read_sweep_study(study_dir).study.get_trials()) == 4
+    other = _graspexp("-m", *STUDY, "trials=3", f"hydra.sweep.dir={study_dir}", ok=False)  # another objective
+    assert other.returncode == 2
+    assert "holds a study of another command (trials: 2 in the study, 3 now)" in other.stderr
 
 
 @pytest.mark.slow
