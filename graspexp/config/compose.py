@@ -72,16 +72,33 @@ def compose_validated(overrides: Sequence[str]) -> DictConfig:
     return cfg
 
 
+def search_ranges(overrides: Sequence[str]) -> list[str]:
+    """The overrides that give a continuous search range (``interval(a, b)``, tagged or not), which only a
+    sampling sweeper (Optuna) can draw from."""
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+    from hydra.core.override_parser.types import IntervalSweep
+
+    mine = [o for o in overrides if not o.lstrip("+~").startswith("hydra")]
+    parsed = OverridesParser.create().parse_overrides(mine)
+    return [text for text, o in zip(mine, parsed, strict=True) if isinstance(o.value(), IntervalSweep)]
+
+
 def expand_sweeps(overrides: Sequence[str]) -> list[list[str]]:
     """Every combination of a multirun's overrides (``mode=collab,bin rot=z,xyz`` -> 4 override lists),
-    in the order Hydra's basic sweeper launches them; ``hydra.*`` overrides are left out."""
+    in the order Hydra's basic sweeper launches them; ``hydra.*`` overrides are left out. An Optuna
+    search range (``interval(a, b)``, also tagged: ``tag(log, interval(a, b))``) stands for its two ends,
+    so both are checked; ``choice(...)`` and ``range(...)`` for each of their values."""
     from hydra.core.override_parser.overrides_parser import OverridesParser
+    from hydra.core.override_parser.types import IntervalSweep
 
     mine = [o for o in overrides if not o.lstrip("+~").startswith("hydra")]
     choices: dict[str, list[str]] = {}
     for o in OverridesParser.create().parse_overrides(mine):
         key = o.get_key_element()
-        if o.is_sweep_override():
+        value = o.value()
+        if isinstance(value, IntervalSweep):
+            choices[key] = [f"{key}={end!r}" for end in (value.start, value.end)]
+        elif o.is_sweep_override():
             choices[key] = [f"{key}={v}" for v in o.sweep_string_iterator()]
         else:
             choices[key] = [f"{key}={o.get_value_element_as_str()}"]

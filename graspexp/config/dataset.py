@@ -7,6 +7,8 @@ from omegaconf import MISSING
 from graspexp.config.constraints import TEXT, Interval, Names, Options, Pattern
 
 LAYOUTS = ("ycb", "bop", "folder", "primitives")
+SPLITS = ("train", "test")
+"""The object splits a catalogued dataset may name (``dataset.split``)."""
 """How a dataset's files are laid out and read (:mod:`graspexp.datasets.catalog`)."""
 
 
@@ -29,6 +31,10 @@ class DatasetConfig:
     """The objects of a run; empty (the shipped options): the dataset's default list, paper Table 1 / Table 2
     order (:data:`graspexp.datasets.catalog.DATASETS`, the one place it is written), or every object of a
     folder or BOP set; ``objects=[...]`` at top level subsets it."""
+    split: str | None = None
+    """``train`` or ``test``: the dataset's named object split instead of its default list (tuning on one,
+    scoring on the other; ``ycb``: train = paper Table 1, test = the other staged objects). None: the
+    default list. Refused together with ``objects=[...]`` (both would choose the objects)."""
     density_kg_m3: float = 700.0
     """Density used for the mass when the dataset publishes none (BOP sets, folders, primitives), kg/m^3."""
     regions: str | None = None
@@ -47,6 +53,7 @@ CONSTRAINTS = {
     "layout": [None, Options(LAYOUTS)],
     "root": [None, *TEXT],
     "objects": [Names()],
+    "split": [None, Options(SPLITS)],
     "density_kg_m3": [Interval(0, 25_000, "right", "kg/m^3")],
     "regions": [None, *TEXT],
     "units": [Pattern(r"m|cm|mm|[0-9]*\.?[0-9]+([eE][-+]?[0-9]+)?", "m, cm, mm or a positive number")],

@@ -13,6 +13,8 @@ RESULT_NEUTRAL_KEYS = (
     "trials",  # which trials run, not what one gives (a trial's seed derives from its object and index)
     "objects",
     "dataset.objects",
+    "dataset.split",  # which objects run
+    "objective",  # what the job returns to a sweeper, computed from the results
     "sim.cache_dir",  # where collision shapes are cached; entries are keyed by mesh content
     "sim.prepare_workers",  # how many processes build the collision shapes, not what they build
     "live",  # whether trials also stream to the Foxglove app

@@ -5,13 +5,16 @@ from typing import Any
 
 from omegaconf import MISSING
 
-from graspexp.config.constraints import BOOL, Interval, Names
+from graspexp.config.constraints import BOOL, Interval, Names, Options
 from graspexp.config.cost import CostConfig
 from graspexp.config.dataset import DatasetConfig
 from graspexp.config.gripper import GripperConfig
 from graspexp.config.mode import ModeConfig
 from graspexp.config.rot import RotConfig
 from graspexp.config.sim import SimConfig
+
+OBJECTIVES = ("success", "worst_object")
+"""The values of ``objective`` (what a job returns to a sweeper)."""
 
 
 @dataclass
@@ -53,6 +56,11 @@ class JobConfig:
     """Port of the live-view server (0: any free port)."""
     progress: bool = True
     """Show a progress bar."""
+    objective: str = "success"
+    """What the job returns to a sweeper (``hydra/sweeper=study`` maximises it), a fraction in [0, 1]:
+    ``success``: the mean over objects of each object's success rate (with equal trials per object, as a
+    job runs them, this equals the mean over all trials); ``worst_object``: the lowest object's success
+    rate (tunes for the hardest object). A job that cannot run returns None (the study marks it FAIL)."""
 
 
 POSE_NOISE_CONSTRAINTS = {
@@ -69,5 +77,6 @@ JOB_CONSTRAINTS = {
     "live": BOOL,
     "live_port": [Interval(0, 65535, integer=True)],
     "progress": BOOL,
+    "objective": [Options(OBJECTIVES)],
 }
 """Allowed values of the top-level keys; the groups have their own (see :mod:`graspexp.config.constraints`)."""

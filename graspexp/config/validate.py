@@ -128,9 +128,21 @@ def _check_urdf_gripper(node: DictConfig) -> None:
         )
 
 
+def _check_split(cfg: DictConfig) -> None:
+    """A split and an explicit object list both choose the objects: refused, not silently merged."""
+    split = OmegaConf.select(cfg, "dataset.split")
+    for key in ("objects", "dataset.objects"):
+        if split is not None and OmegaConf.select(cfg, key):
+            raise ConfigError(
+                f"dataset.split={split!r} is invalid together with {key}=[...]: both choose the objects; "
+                "give one of them"
+            )
+
+
 def validate(cfg: DictConfig | Any) -> None:
     """Raise :class:`ConfigError` naming the first dotted key whose value is unknown, missing or invalid.
     A URDF gripper's file is read here, and its stroke fills an unset ``gripper.max_width_m``."""
     _check_urdf_gripper(OmegaConf.select(cfg, "gripper", throw_on_missing=False))
     _check_node(cfg, job.JobConfig, "")
     _check_relations(cfg)
+    _check_split(cfg)

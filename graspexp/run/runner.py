@@ -389,8 +389,18 @@ def object_notes(models: dict[str, LoadedObject], unusable: dict[str, str]) -> s
     return "\n\nObjects:\n" + "\n".join(lines) if lines else ""
 
 
+OBJECTIVES = {"success": pd.Series.mean, "worst_object": pd.Series.min}
+"""How each ``objective`` (:data:`graspexp.config.job.OBJECTIVES`) reduces the per-object success rates."""
+
+
+def objective_value(df: pd.DataFrame, objective: str) -> float:
+    """The job's ``objective`` (see :class:`graspexp.config.JobConfig`) from its results table (one row per
+    trial, columns ``object`` and ``success``): a fraction in [0, 1]."""
+    return float(OBJECTIVES[objective](df.groupby("object", sort=False)["success"].mean()))
+
+
 def run_job(cfg: DictConfig) -> float:
-    """Run every trial for every selected object; returns the overall success rate in [0, 1]."""
+    """Run every trial for every selected object; returns ``cfg.objective`` (:func:`objective_value`)."""
     from hydra.core.hydra_config import HydraConfig
 
     return run_in_dir(cfg, Path(HydraConfig.get().runtime.output_dir), write_hydra_record)
@@ -466,4 +476,4 @@ def _run_trials(
         f" ({len(df)} trials, {time.perf_counter() - wall0:.1f} s wall, {time.process_time() - cpu0:.1f} s CPU)"
     )
     print(text)
-    return float(df["success"].mean())
+    return objective_value(df, cfg.objective)

@@ -13,6 +13,7 @@ TOOLS: tuple[str, ...] = (
     "prepare",
     "area",
     "config_reference",
+    "tune",
     "bench.trials",
     "bench.plan_latency",
     "bench.collision_shapes",

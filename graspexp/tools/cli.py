@@ -21,7 +21,7 @@ from collections.abc import Callable, Sequence
 from omegaconf import DictConfig
 
 from graspexp.config import ConfigError
-from graspexp.config.compose import compose_validated, expand_sweeps, one_line
+from graspexp.config.compose import compose_validated, expand_sweeps, one_line, search_ranges
 from graspexp.config.registry import group_options
 from graspexp.tools import TOOLS
 
@@ -110,6 +110,11 @@ def check_overrides(overrides: Sequence[str], multirun: bool = True) -> None:
         fail(
             f"{' '.join(swept)} sweeps over several values: add -m (--multirun), or give a list as key=[a,b]"
         )
+    ranges = search_ranges(overrides)
+    if ranges and not any(o.startswith("hydra/sweeper=") for o in overrides):
+        fail(
+            f"{' '.join(ranges)} is a search range, which only an Optuna study draws from: add hydra/sweeper=study"
+        )
     for combo in combos:
         compose_checked(combo)
 
@@ -121,7 +126,7 @@ def _groups_epilog() -> str:
         for g in ("dataset", "mode", "rot", "gripper", "planner", "cost", "sim")
     ]
     lines.append(
-        "top-level keys: trials, seed, objects, record, live, live_port, progress, perception.noise.*"
+        "top-level keys: trials, seed, objects, record, live, live_port, progress, objective, perception.noise.*"
     )
     lines.append(f"tools (python -m graspexp TOOL --help): {', '.join(TOOLS)}")
     lines.append(

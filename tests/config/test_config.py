@@ -119,7 +119,7 @@ def test_out_of_range_values_name_the_key(override, message):
         (
             ["+foo=1"],
             "graspexp: error: foo=1 is invalid: 'foo' is not a key of the job config; expected one of "
-            "dataset, mode, rot, gripper, planner, cost, sim, perception, trials, seed, objects, record, live, live_port, progress",
+            "dataset, mode, rot, gripper, planner, cost, sim, perception, trials, seed, objects, record, live, live_port, progress, objective",
         ),
     ],
 )

@@ -284,3 +284,14 @@ def test_any_catalogue_object_can_be_selected_not_only_the_default_list():
     assert select_objects(ycb, ["002_master_chef_can", "025_mug"]) == ["002_master_chef_can", "025_mug"]
     with pytest.raises(DatasetError, match=r"unknown object\(s\) \['teapot'\] in dataset 'ycb'; valid: 002_"):
         select_objects(ycb, ["teapot"])
+
+
+def test_splits_choose_the_objects_and_do_not_overlap() -> None:
+    ycb = DATASETS["ycb"]
+    assert ycb.splits["train"] == ycb.default_objects  # paper Table 1
+    assert len(ycb.splits["test"]) == 14 and not set(ycb.splits["test"]) & set(ycb.splits["train"])
+    assert set(ycb.splits["test"]) <= set(ycb.catalogue)
+    cfg = compose_cfg("dataset=ycb", "dataset.split=test").dataset
+    assert dataset_objects(cfg) == list(ycb.splits["test"])
+    with pytest.raises(DatasetError, match="dataset 'linemod' has no 'train' split"):
+        dataset_objects(compose_cfg("dataset=linemod", "dataset.split=train").dataset)
