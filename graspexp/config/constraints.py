@@ -27,7 +27,8 @@ def _is_int(v: object) -> bool:
     return isinstance(v, int) and not isinstance(v, bool)
 
 
-def _is_real(v: object) -> bool:
+def is_real(v: object) -> bool:
+    """A finite int or float, not a bool (YAML ``true`` is not 1)."""
     return (isinstance(v, int | float) and not isinstance(v, bool)) and math.isfinite(v)
 
 
@@ -43,7 +44,7 @@ class Interval:
     integer: bool = False
 
     def accepts(self, v: object) -> bool:
-        if not (_is_int(v) if self.integer else _is_real(v)):
+        if not (_is_int(v) if self.integer else is_real(v)):
             return False
         lo_ok = self.low is None or (v >= self.low if self.closed in ("both", "left") else v > self.low)
         hi_ok = self.high is None or (v <= self.high if self.closed in ("both", "right") else v < self.high)

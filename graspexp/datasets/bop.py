@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from graspexp.config.constraints import is_real
 from graspexp.datasets.errors import DatasetError
 
 MM_TO_M = 1e-3
@@ -138,20 +139,20 @@ def _model_info(path: Path, key: str, entry: Any) -> ModelInfo:
         value = entry.get(name)
         if name not in _SIZE_KEYS and value is None:
             continue  # optional: only the sizes are needed here
-        if not _finite(value) or (name in _SIZE_KEYS + ("diameter",) and value <= 0):
+        if not is_real(value) or (name in _SIZE_KEYS + ("diameter",) and value <= 0):
             raise DatasetError(
                 f"{where}: {name} must be a {'positive ' if 'min' not in name else ''}number (mm), got {value!r}"
             )
     discrete = entry.get("symmetries_discrete", [])
     if not isinstance(discrete, list) or not all(
-        isinstance(m, list) and len(m) == 16 and all(_finite(x) for x in m) for m in discrete
+        isinstance(m, list) and len(m) == 16 and all(is_real(x) for x in m) for m in discrete
     ):
         raise DatasetError(f"{where}: symmetries_discrete must be a list of 16-number row-major 4x4 matrices")
     continuous = entry.get("symmetries_continuous", [])
     axes = []
     for sym in continuous if isinstance(continuous, list) else [None]:
         axis = sym.get("axis") if isinstance(sym, dict) else None
-        if not (isinstance(axis, list) and len(axis) == 3 and all(_finite(a) for a in axis)):
+        if not (isinstance(axis, list) and len(axis) == 3 and all(is_real(a) for a in axis)):
             raise DatasetError(
                 f"{where}: symmetries_continuous must be a list of {{axis: [x, y, z], offset: [...]}}"
             )
@@ -163,7 +164,3 @@ def _model_info(path: Path, key: str, entry: Any) -> ModelInfo:
         n_discrete_symmetries=len(discrete),
         continuous_axes=tuple(axes),
     )
-
-
-def _finite(value: object) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)

@@ -33,6 +33,8 @@ import numpy as np
 import yaml
 from scipy.spatial.transform import Rotation
 
+from graspexp.config import dataset
+from graspexp.config.constraints import Interval
 from graspexp.datasets.errors import DatasetError, ObjectError
 from graspexp.datasets.regions import parse_entry
 from graspexp.datasets.source import MeshPart, ObjectSource
@@ -42,6 +44,12 @@ MESH_SUFFIXES = (".obj", ".ply", ".stl", ".glb", ".gltf", ".off")
 UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 """Unit names -> metres per file unit."""
 SIDECAR_KEYS = ("units", "mass_kg", "density_kg_m3", "friction", "area", "note")
+SIDECAR_NUMBERS = {
+    "mass_kg": Interval(0, 100, "right", "kg"),
+    "density_kg_m3": dataset.CONSTRAINTS["density_kg_m3"][0],  # the bounds of dataset.density_kg_m3
+    "friction": Interval(0, 5, "right"),
+}
+"""The numeric sidecar keys and their allowed values."""
 
 
 @dataclass(frozen=True)
@@ -168,11 +176,9 @@ def read_sidecar(path: Path) -> dict[str, Any]:
         raise ObjectError(f"sidecar {path}: unknown key(s) {unknown}; valid keys: {', '.join(SIDECAR_KEYS)}")
     if "mass_kg" in data and "density_kg_m3" in data:
         raise ObjectError(f"sidecar {path}: give mass_kg or density_kg_m3, not both")
-    for key, high in (("mass_kg", 100.0), ("density_kg_m3", 25_000.0), ("friction", 5.0)):
-        if key in data and not (_number(data[key]) and 0 < data[key] <= high):
-            raise ObjectError(
-                f"sidecar {path}: {key}={data[key]!r} is invalid: expected a number in (0, {high:g}]"
-            )
+    for key, allowed in SIDECAR_NUMBERS.items():
+        if key in data and not allowed.accepts(data[key]):
+            raise ObjectError(f"sidecar {path}: {key}={data[key]!r} is invalid: expected {allowed}")
     if "units" in data:
         units_factor(data["units"], f"sidecar {path}: units")
     if "note" in data and not isinstance(data["note"], str):
@@ -284,7 +290,3 @@ def _origin(el: ET.Element | None, path: Path, what: str) -> tuple[tuple[float, 
     pose[:3, :3] = Rotation.from_euler("xyz", rpy).as_matrix()  # URDF rpy: fixed-axis roll, pitch, yaw
     pose[:3, 3] = xyz
     return tuple(tuple(float(v) for v in row) for row in pose)
-
-
-def _number(value: object) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)

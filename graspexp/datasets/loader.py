@@ -211,7 +211,7 @@ def load_object(cfg: Any, name: str, n_points: int, seed: int) -> ObjectModel:
     # Sample on the cached mesh (its face areas and normals are computed once); hand out a copy.
     points, face_index = trimesh.sample.sample_surface(entry.mesh, int(n_points), seed=int(seed))
     normals = entry.mesh.face_normals[face_index]
-    data_dirs = (dataset_dir(cfg), resolve_root(cfg)) if source.parts else (dataset_dir(cfg),)
+    data_dirs = (dataset_dir(cfg), resolve_root(cfg))
     mask = area_mask(spec, points, entry.mesh.bounds, data_dirs=data_dirs)
     return ObjectModel(
         name=name,

@@ -48,10 +48,13 @@ import trimesh
 import yaml
 from sklearn.neighbors import KDTree
 
+from graspexp.config.constraints import Interval
 from graspexp.datasets.errors import DatasetError, ObjectError
 
 REGIONS_DIR = Path(__file__).parent / "regions"
 """Folder of the version-controlled region spec files."""
+POSITIVE = Interval(0, None, "neither")
+"""A finite positive number (``scale``, ``tolerance_m``)."""
 MESHLAB_TOLERANCE_FACTOR = 1.5
 """Default import tolerance = this factor x the median nearest-neighbour spacing of the area cloud."""
 
@@ -224,7 +227,7 @@ def _flag(value: Any, what: str) -> bool:
 
 def _positive(value: Any, what: str) -> float:
     """``value`` as a float if it is a finite positive number, else a DatasetError naming ``what``."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not (0 < value < float("inf")):
+    if not POSITIVE.accepts(value):
         raise DatasetError(f"{what} must be a positive number, got {value!r}")
     return float(value)
 

@@ -16,6 +16,7 @@ With ``record=false`` no log is written (faster, but nothing to replay and nothi
 import dataclasses
 import datetime
 import errno
+import functools
 import hashlib
 import logging
 import os
@@ -102,6 +103,7 @@ def job_metadata(cfg: DictConfig) -> dict[str, str]:
     return meta
 
 
+@functools.cache
 def machine_fingerprint() -> dict[str, str]:
     """What a trial's floating point may depend on besides the code: CPU model, its instruction-set flags
     (a hash: PhysX and numba pick vector paths by them), OS and architecture."""
@@ -145,14 +147,14 @@ def _unusable_object_trials(
 ) -> list[TrialResult]:
     """Every trial of an object that cannot be used: an ``error`` result with ``reason``, logged (when
     ``record``) so that the report counts it; resume tries the object again."""
-    plain = plain_config(cfg)
+    plain, job_meta = plain_config(cfg), job_metadata(cfg)
     results = []
     for i in range(cfg.trials):
         seed = trial_seed(plain, object_name, i)
         result = _error_result(cfg, object_name, i, seed, ObjectError(reason))
         path = trial_log_path(run_dir, object_name, i)
         path.parent.mkdir(parents=True, exist_ok=True)
-        meta = {**job_metadata(cfg), "object": object_name, "trial": str(i), "trial_seed": str(seed)}
+        meta = {**job_meta, "object": object_name, "trial": str(i), "trial_seed": str(seed)}
         with trial_recorder(path if cfg.record else None, meta, plain) as rec:
             rec.result(0.0, result.to_dict())
         results.append(result)
