@@ -22,7 +22,7 @@ from typing import Any
 from graspexp.datasets import bop, folder
 from graspexp.datasets.errors import DatasetError
 from graspexp.datasets.source import MeshPart, ObjectSource
-from graspexp.datasets.ycb_objects import YCB_MASS_KG
+from graspexp.datasets.ycb_objects import GOOGLE_16K_FACES, YCB_MASS_KG
 
 DATA_ENV = "GRASPEXP_DATA"
 """Environment variable naming the data root when ``dataset.root`` is not set."""
@@ -194,8 +194,15 @@ def _bop_models(cfg: Any) -> tuple[Path, dict[str, int]]:
         raise DatasetError(
             f"BOP dataset folder {models.resolve()} does not exist (dataset.root / ${DATA_ENV})"
         )
-    bop_set = getattr(cfg, "bop_set", None) or dataset_dir(cfg).name
-    return models, bop.object_names(bop.model_ids(models), str(bop_set))
+    return models, bop.object_names(bop.model_ids(models), _bop_set(cfg))
+
+
+def _bop_set(cfg: Any) -> str:
+    """The BOP set's short name (``linemod`` for the catalogued instance, else ``dataset.bop_set`` or the
+    folder's name), lower case."""
+    if catalogued(cfg) is not None:
+        return str(cfg.name).lower()
+    return str(getattr(cfg, "bop_set", None) or dataset_dir(cfg).name).lower()
 
 
 def catalogue(cfg: Any) -> tuple[str, ...]:
@@ -282,20 +289,30 @@ def object_source(cfg: Any, name: str) -> ObjectSource:
     path = mesh_path(cfg, name)
     if layout == "ycb":
         return ObjectSource(
-            name=name, parts=(MeshPart(path),), source=str(path.resolve()), mass_kg=YCB_MASS_KG[name]
+            name=name,
+            parts=(MeshPart(path),),
+            source=str(path.resolve()),
+            mass_kg=YCB_MASS_KG[name],
+            published_faces=GOOGLE_16K_FACES if path.parent.name == "google_16k" else None,
         )
     models, ids = _bop_models(cfg)
     info = bop.read_models_info(models).get(ids[name]) if (models / bop.INFO_FILE).is_file() else None
-    notes = (
-        "units: mm (BOP)",
-        "mass: volume x dataset.density_kg_m3",
-        info.symmetry_note() if info else f"size not checked: no entry in {models / bop.INFO_FILE}",
-    )
+    carried = bop.PUBLISHED_SIZES_MM.get(_bop_set(cfg), {}).get(ids[name])
+    where = str(models / bop.INFO_FILE)
+    if info is not None:
+        size, size_note = info.size_mm, info.symmetry_note()
+    elif carried is not None:
+        where = f"the {_bop_set(cfg)} set's models_info.json (carried by graspexp: {where} has no entry)"
+        size, size_note = carried, f"size checked against {where}"
+    else:
+        size, size_note = None, f"size not checked: no entry in {where}"
+    notes = ("units: mm (BOP)", "mass: volume x dataset.density_kg_m3", size_note)
     return ObjectSource(
         name=name,
         parts=(MeshPart(path, scale=bop.MM_TO_M),),
         source=str(path.resolve()),
-        published_size=info.size_mm if info else None,
+        published_size=size,
+        published_where=where,
         notes=tuple(n for n in notes if n),
     )
 

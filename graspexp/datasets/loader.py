@@ -22,7 +22,12 @@ from graspexp.datasets.catalog import (
     resolve_root,
 )
 from graspexp.datasets.errors import DatasetError, ObjectError
-from graspexp.datasets.meshcheck import check_file, check_geometry, check_published_size
+from graspexp.datasets.meshcheck import (
+    check_file,
+    check_geometry,
+    check_published_faces,
+    check_published_size,
+)
 from graspexp.datasets.model import ObjectModel
 from graspexp.datasets.primitives import PRIMITIVES
 from graspexp.datasets.regions import RegionSpec, area_mask, load_region_specs, regions_path, whole_surface
@@ -159,10 +164,15 @@ def _object_mesh(cfg: Any, name: str) -> tuple[MeshEntry, ObjectSource]:
         entry = load_mesh(single.file, single.scale)
     else:
         entry = _assembled(source)
+    if source.published_faces is not None:
+        check_published_faces(single.file, source.published_faces)
     if source.published_size is not None:
         scale = np.asarray(single.scale, dtype=float)
         check_published_size(
-            Path(source.source), entry.mesh.extents / scale, np.asarray(source.published_size)
+            Path(source.source),
+            entry.mesh.extents / scale,
+            np.asarray(source.published_size),
+            source.published_where,
         )
     check_geometry(source.source, entry.mesh.extents, source.units_hint)
     return entry, source

@@ -2,10 +2,13 @@
 
 - OBJ: the element counts some exporters write in the header (``# Vertices: N`` / ``# Faces: N``, e.g.
   the Katamari encoder of the YCB google_16k meshes) against the ``v`` and ``f`` lines present.
-- PLY: the header's ``element`` counts against the body (ASCII: one line per element; binary: the bytes
-  the fixed-size elements need at least).
+- PLY: the header's ``element`` counts against the body, exactly (ASCII: one line per element; binary: the
+  elements' bytes, list lengths read from the body).
+- YCB google_16k: every model has :data:`graspexp.datasets.ycb_objects.GOOGLE_16K_FACES` faces
+  (:func:`check_published_faces`), so a file cut together with its header is caught too.
 - BOP: ``models_info.json`` beside the models publishes each model's size; the loaded extents must match
-  it (:func:`check_published_size`).
+  it (:func:`check_published_size`); LINEMOD models without an entry there are checked against the sizes
+  the library carries (:data:`graspexp.datasets.bop.LM_SIZES_MM`).
 - Any dataset mesh: a sane size (:data:`MIN_EXTENT_M` ... :data:`MAX_EXTENT_M`). (The loader also
   requires a closed mesh to enclose a positive volume no larger than its convex hull's.) No dataset here
   publishes volumes or watertightness, so those are checked for consistency only.
@@ -29,6 +32,9 @@ BOP_SIZE_TOLERANCE = 0.01
 _OBJ_HEADER = re.compile(rb"^#\s*(vertices|faces)\s*:\s*(\d+)\s*$", re.IGNORECASE | re.MULTILINE)
 _PLY_SIZES = {"char": 1, "uchar": 1, "int8": 1, "uint8": 1, "short": 2, "ushort": 2, "int16": 2, "uint16": 2,
               "int": 4, "uint": 4, "int32": 4, "uint32": 4, "float": 4, "float32": 4, "double": 8, "float64": 8}  # fmt: skip
+_PLY_NUMPY = {"char": "i1", "uchar": "u1", "int8": "i1", "uint8": "u1", "short": "i2", "ushort": "u2",
+              "int16": "i2", "uint16": "u2", "int": "i4", "uint": "u4", "int32": "i4", "uint32": "u4"}  # fmt: skip
+"""numpy dtypes of the PLY integer types a list's length field may have."""
 
 
 def _damaged(path: Path, what: str) -> ObjectError:
@@ -53,40 +59,75 @@ def check_obj(path: Path, data: bytes) -> None:
 
 
 def check_ply(path: Path, data: bytes) -> None:
-    """Raise ObjectError if an ASCII PLY body holds other than the rows its header's element counts say, or a
-    binary body fewer bytes than they need."""
+    """Raise ObjectError unless a PLY body holds exactly what its header's element counts declare: ASCII one
+    row per element, binary the elements' bytes (list lengths read from the body; a binary file whose face
+    lengths vary is left to the loader)."""
     end = data.find(b"end_header")
     if not data.startswith(b"ply") or end < 0:
         raise _damaged(path, "no complete PLY header")
     header = data[:end].decode("ascii", "replace").splitlines()
     body = data[data.index(b"\n", end) + 1 :] if b"\n" in data[end:] else b""
     fmt = next((ln.split()[1] for ln in header if ln.startswith("format ")), "ascii")
-    elements: list[tuple[str, int, int, bool]] = []  # name, count, fixed bytes per element, has a list
+    elements: list[tuple[str, int, list[tuple[str, ...]]]] = []  # name, count, property types
     for ln in header:
         parts = ln.split()
         if parts[:1] == ["element"] and len(parts) == 3:
-            elements.append((parts[1], int(parts[2]), 0, False))
+            elements.append((parts[1], int(parts[2]), []))
         elif parts[:1] == ["property"] and elements:
-            name, count, size, has_list = elements[-1]
-            if parts[1] == "list":  # count type, then at least 3 indices for a face
-                size += _PLY_SIZES.get(parts[2], 1) + 3 * _PLY_SIZES.get(parts[3], 4)
-                has_list = True
-            else:
-                size += _PLY_SIZES.get(parts[1], 4)
-            elements[-1] = (name, count, size, has_list)
+            elements[-1][2].append(tuple(parts[2:4]) if parts[1] == "list" else (parts[1],))
+    counts = ", ".join(f"{count} {name}" for name, count, _ in elements)
     if fmt == "ascii":
         rows = sum(1 for ln in body.split(b"\n") if ln.strip())
-        needed = sum(count for _, count, _, _ in elements)
+        needed = sum(count for _, count, _ in elements)
         if rows != needed:  # exact: rows beyond the declared counts are data the reader would drop
-            counts = ", ".join(f"{count} {name}" for name, count, _, _ in elements)
             raise _damaged(path, f"its header declares {counts} ({needed} rows), the file holds {rows} rows")
-    else:
-        needed = sum(count * size for _, count, size, _ in elements)
-        if len(body) < needed:
-            counts = ", ".join(f"{count} {name}" for name, count, _, _ in elements)
-            raise _damaged(
-                path, f"its header declares {counts}, which need {needed} bytes; the file holds {len(body)}"
-            )
+        return
+    order = "<" if fmt == "binary_little_endian" else ">"
+    offset = 0
+    for _, count, props in elements:
+        end = _binary_element_end(body, offset, count, props, order)
+        if end is None:
+            return
+        offset = end
+        if offset > len(body):
+            break
+    if offset != len(body):  # exact: bytes beyond the declared elements are data the reader would drop
+        held = (
+            f"the body ends early, after {len(body)} bytes"
+            if offset > len(body)
+            else f"the file holds {len(body) - offset} bytes more than those"
+        )
+        raise _damaged(path, f"its header declares {counts}; {held}")
+
+
+def _binary_element_end(
+    body: bytes, offset: int, count: int, props: list[tuple[str, ...]], order: str
+) -> int | None:
+    """The byte offset after ``count`` binary elements with properties ``props`` starting at ``offset`` (past
+    the body's end if it is too short). Lists must have the first row's lengths in every row (triangle or
+    quad meshes: one strided read); None if they vary (trimesh cannot read such a file and says so)."""
+    if not any(len(p) == 2 for p in props):
+        return offset + count * sum(_PLY_SIZES.get(p[0], 4) for p in props)
+    if count == 0:
+        return offset
+    fields, pos = [], offset
+    for p in props:  # the first row: where its length fields are, and their values
+        if len(p) == 1:
+            pos += _PLY_SIZES.get(p[0], 4)
+            continue
+        dtype = np.dtype(_PLY_NUMPY.get(p[0], "u1")).newbyteorder(order)
+        if pos + dtype.itemsize > len(body):
+            return len(body) + 1
+        n = int(np.frombuffer(body, dtype, 1, pos)[0])
+        fields.append((pos - offset, dtype, n))
+        pos += dtype.itemsize + n * _PLY_SIZES.get(p[1], 4)
+    stride = pos - offset
+    end = offset + count * stride
+    if end > len(body):
+        return end
+    rows = np.frombuffer(body, np.uint8, count * stride, offset).reshape(count, stride)
+    same = all(np.all(rows[:, at : at + dt.itemsize].copy().view(dt).ravel() == n) for at, dt, n in fields)
+    return end if same else None
 
 
 def check_file(path: Path) -> None:
@@ -100,6 +141,14 @@ def check_file(path: Path) -> None:
         check_obj(path, data)
     elif suffix == ".ply":
         check_ply(path, data)
+
+
+def check_published_faces(path: Path, expected: int) -> None:
+    """Raise ObjectError unless the OBJ file ``path`` holds the face count its dataset publishes (a file cut
+    together with its header declares nothing itself)."""
+    n_faces = obj_counts(path.read_bytes())[1]
+    if n_faces != expected:
+        raise _damaged(path, f"it holds {n_faces} faces, its dataset's models have {expected}")
 
 
 def check_geometry(what: str, extents_m: np.ndarray, units_hint: str = "") -> None:
@@ -125,11 +174,14 @@ def check_geometry(what: str, extents_m: np.ndarray, units_hint: str = "") -> No
     )
 
 
-def check_published_size(path: Path, extents_file_units: np.ndarray, published: np.ndarray) -> None:
-    """Compare a model's extents (file units) with the size its dataset publishes (BOP ``models_info.json``)."""
+def check_published_size(
+    path: Path, extents_file_units: np.ndarray, published: np.ndarray, where: str
+) -> None:
+    """Compare a model's extents (file units) with the size its dataset publishes; ``where`` names the
+    publication (e.g. ``models_info.json``) in the message."""
     if np.any(np.abs(extents_file_units - published) > 0.5 + BOP_SIZE_TOLERANCE * published):
         raise _damaged(
             path,
             f"its extents {np.round(extents_file_units, 2).tolist()} differ from the published size "
-            f"{np.round(published, 2).tolist()} in models_info.json",
+            f"{np.round(published, 2).tolist()} in {where}",
         )

@@ -41,6 +41,17 @@ class ObjectModel:
         digest.update(np.ascontiguousarray(self.mesh.faces, dtype=np.int64).tobytes())
         return digest.hexdigest()
 
+    @cached_property
+    def mesh_facts(self) -> dict[str, str]:
+        """What the geometry is, readable: face count, surface area (m^2) and enclosed volume (m^3, "" if the
+        mesh is not closed), as log metadata strings; a cut or rescaled file changes them."""
+        closed = bool(self.mesh.is_watertight)
+        return {
+            "mesh_faces": str(len(self.mesh.faces)),
+            "mesh_area_m2": f"{float(self.mesh.area):.6e}",
+            "mesh_volume_m3": f"{float(self.mesh.volume):.6e}" if closed else "",
+        }
+
     @property
     def area_points(self) -> np.ndarray:
         """(n_area, 3) grasping-area points, object frame, metres."""

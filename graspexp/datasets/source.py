@@ -43,6 +43,10 @@ class ObjectSource:
     """A sidecar's Coulomb friction of the object (static and dynamic); None: ``sim.object_*_friction``."""
     published_size: tuple[float, float, float] | None = None
     """Extents the dataset publishes (BOP ``models_info.json``), file units; the loaded mesh must match."""
+    published_faces: int | None = None
+    """Face count the dataset publishes for this file (YCB google_16k); the file must hold exactly that many."""
+    published_where: str = "models_info.json"
+    """Where ``published_size`` comes from (said when the mesh disagrees with it)."""
     units_hint: str = ""
     """Where a user sets the units of this object (said when its size is implausible); "" if fixed."""
     notes: tuple[str, ...] = ()

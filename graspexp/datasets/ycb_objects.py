@@ -90,3 +90,7 @@ YCB_MASS_KG: dict[str, float] = {
     "077_rubiks_cube": 0.094,
 }
 """Object id -> published mass, kg (the catalogue of the ``ycb`` layout)."""
+
+GOOGLE_16K_FACES = 16384
+"""Faces of every google_16k model: Google's scans decimated to 16k (2^14) triangles (each file's own
+``# Faces:`` header says so where it has one). A google_16k file holding another count is cut or damaged."""

@@ -127,8 +127,8 @@ def machine_fingerprint() -> dict[str, str]:
 
 def _metadata(job_meta: dict[str, str], loaded: LoadedObject, trial: int, seed: int) -> dict[str, str]:
     """One trial's log metadata: the job's, the trial's seeds and what its object was made of (the mesh
-    file, "" for a procedural one, the SHA-256 of the geometry used, the collision method it got, and what
-    was assumed for it: units, mass, area)."""
+    file, "" for a procedural one, the SHA-256 of the geometry used with its face count, surface area and
+    volume, the collision method it got, and what was assumed for it: units, mass, area)."""
     return {
         **job_meta,
         "object": loaded.model.name,
@@ -136,6 +136,7 @@ def _metadata(job_meta: dict[str, str], loaded: LoadedObject, trial: int, seed: 
         "trial_seed": str(seed),
         "mesh_source": loaded.model.source,
         "mesh_sha256": loaded.model.mesh_sha256,
+        **loaded.model.mesh_facts,
         "collision_method": loaded.hulls.method,
         "collision_key": loaded.hulls.key,
         "object_notes": "\n".join(loaded.notes),
@@ -178,10 +179,19 @@ def check_same_meshes(run_dir: Path, models: dict[str, ObjectModel]) -> None:
             continue
         raise RunError(
             f"{run_dir} holds trials of {model.name} made on another mesh ({path.relative_to(run_dir)}: "
-            f"{meta.get('mesh_source') or 'procedural'}, sha256 {logged[:12]}; now "
-            f"{model.source or 'procedural'}, sha256 {model.mesh_sha256[:12]}); resume only reuses trials "
-            f"of the same mesh: choose another output directory or delete {run_dir / 'trials'}"
+            f"{meta.get('mesh_source') or 'procedural'}, sha256 {logged[:12]}{_facts(meta)}; now "
+            f"{model.source or 'procedural'}, sha256 {model.mesh_sha256[:12]}{_facts(model.mesh_facts)}); "
+            f"resume only reuses trials of the same mesh: choose another output directory or delete "
+            f"{run_dir / 'trials'}"
         )
+
+
+def _facts(meta: dict[str, str]) -> str:
+    """ ", N faces, area A m^2, volume V m^3" from recorded mesh facts ("" for logs without them)."""
+    if "mesh_faces" not in meta:
+        return ""
+    volume = f", volume {float(meta['mesh_volume_m3']):.4g} m^3" if meta.get("mesh_volume_m3") else ""
+    return f", {meta['mesh_faces']} faces, area {float(meta['mesh_area_m2']):.4g} m^2{volume}"
 
 
 def _error_result(

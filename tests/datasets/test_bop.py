@@ -71,8 +71,29 @@ def test_a_set_with_human_names_uses_them(tmp_path):
 def test_a_model_that_disagrees_with_models_info_is_refused(tmp_path):
     root = make_bop_set(tmp_path / "hb")
     trimesh.creation.box(extents=(30.0, 18.0, 48.0)).export(root / "models" / "obj_000001.ply")  # x0.6
-    with pytest.raises(ObjectError, match="differ from the published size .* in models_info.json"):
+    with pytest.raises(ObjectError, match="differ from the published size .* in .*models_info.json"):
         load_object(bop_cfg(root), "obj_000001", 16, 0)
+
+
+def test_a_linemod_model_without_models_info_is_checked_against_the_published_size(tmp_path):
+    """LM-O ships models_info.json with 8 of 15 entries, a user's copy may lack it: the sizes graspexp carries
+    for the 13 LINEMOD models still catch a model at the wrong scale."""
+    models = tmp_path / "linemod" / "models"
+    models.mkdir(parents=True)
+    ape = trimesh.creation.box(extents=(75.8686, 77.5992, 91.769))  # ape's published size, mm
+    ape.export(models / "obj_000001.ply")
+    cfg = compose_cfg("dataset=linemod", f"dataset.root={tmp_path}").dataset
+    notes = load_object(cfg, "ape", 16, 0).notes
+    assert any(n.startswith("size checked against the linemod set's models_info.json") for n in notes)
+    ape.apply_scale(0.6)
+    ape.export(models / "obj_000001.ply")
+    with pytest.raises(
+        ObjectError, match=r"obj_000001.ply: .*differ from the published size \[75.87, 77.6, 91.77\]"
+    ):
+        load_object(cfg, "ape", 16, 0)
+    bop = bop_cfg(tmp_path / "linemod", "dataset.bop_set=lmo")  # any lm/lmo copy, not just the catalogued one
+    with pytest.raises(ObjectError, match="carried by graspexp"):
+        load_object(bop, "ape", 16, 0)
 
 
 @pytest.mark.parametrize(

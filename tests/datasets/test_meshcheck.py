@@ -45,6 +45,20 @@ def test_obj_cut_to_a_few_hundred_bytes_is_the_same_clear_error(data_root: Path,
         load_object(_cfg("ycb", tmp_path), "025_mug", 64, 0)
 
 
+def test_obj_cut_together_with_its_header_is_refused(data_root: Path, tmp_path: Path) -> None:
+    """A google_16k file that lost its ``# Faces:`` header still has its dataset's published face count."""
+    lines = (data_root / "ycb" / "025_mug" / "google_16k" / "textured.obj").read_bytes().split(b"\n")
+    faces = [i for i, ln in enumerate(lines) if ln.startswith(b"f ")]
+    kept = [ln for ln in lines[: faces[6099]] if not ln.startswith(b"#")]  # 6,099 of 16,384 faces, no header
+    path = _ycb_mug(tmp_path, b"\n".join(kept))
+    with pytest.raises(DatasetError) as err:
+        load_object(_cfg("ycb", tmp_path), "025_mug", 64, 0)
+    assert str(err.value) == (
+        f"broken mesh {path.resolve()}: it holds 6099 faces, its dataset's models have 16384 "
+        "(a cut or damaged file?); download it again"
+    )
+
+
 def _linemod_ape(root: Path, data: bytes) -> Path:
     path = root / "linemod" / "models" / "obj_000001.ply"
     path.parent.mkdir(parents=True)
@@ -61,17 +75,45 @@ def test_ascii_ply_cut_short_is_refused(data_root: Path, tmp_path: Path) -> None
         load_object(_cfg("linemod", tmp_path), "ape", 64, 0)
 
 
-def test_binary_ply_cut_short_is_refused(tmp_path: Path) -> None:
-    data = trimesh.creation.icosphere(subdivisions=3, radius=40.0).export(file_type="ply", encoding="binary")
-    path = _linemod_ape(tmp_path, data[:-200])
-    with pytest.raises(
-        DatasetError, match=rf"^broken mesh {path.resolve()}: its header declares 642 vertex, 1280 face"
-    ):
-        load_object(_cfg("linemod", tmp_path), "ape", 64, 0)
+def _folder_ply(root: Path, data: bytes) -> tuple[Path, DatasetConfig]:
+    path = root / "ball.ply"
     path.write_bytes(data)
-    assert load_object(_cfg("linemod", tmp_path), "ape", 64, 0).mesh.extents.max() == pytest.approx(
-        0.08, rel=0.01
+    return path, DatasetConfig(name="mine", layout="folder", root=str(root), units="mm")
+
+
+@pytest.mark.parametrize(
+    "cut, held", [(-200, "the body ends early"), (+13, "the file holds 13 bytes more than those")]
+)
+def test_binary_ply_with_other_than_its_declared_bytes_is_refused(
+    tmp_path: Path, cut: int, held: str
+) -> None:
+    data = trimesh.creation.icosphere(subdivisions=3, radius=40.0).export(file_type="ply", encoding="binary")
+    body = data[:cut] if cut < 0 else data + bytes([3]) + bytes(12)  # cut short / one undeclared triangle
+    path, cfg = _folder_ply(tmp_path, body)
+    with pytest.raises(
+        DatasetError,
+        match=rf"^broken mesh {path.resolve()}: its header declares 642 vertex, 1280 face; {held}",
+    ):
+        load_object(cfg, "ball", 64, 0)
+    path.write_bytes(data)
+    assert load_object(cfg, "ball", 64, 0).mesh.extents.max() == pytest.approx(0.08, rel=0.01)
+
+
+def test_binary_ply_of_quads_is_counted_by_its_length_fields(tmp_path: Path) -> None:
+    vertices = np.array([[x, y, z] for x in (0, 50) for y in (0, 50) for z in (0, 50)], dtype="<f4")
+    quads = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    header = (
+        "ply\nformat binary_little_endian 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 6\nproperty list uchar int vertex_indices\nend_header\n"
     )
+    body = vertices.tobytes() + b"".join(bytes([4]) + np.array(q, "<i4").tobytes() for q in quads)
+    path, cfg = _folder_ply(tmp_path, header.encode() + body)
+    assert load_object(cfg, "ball", 64, 0).mesh.extents.tolist() == pytest.approx([0.05] * 3)
+    path.write_bytes(header.encode() + body[:-4])  # 96 + 6 x 17 bytes declared, 4 fewer held
+    with pytest.raises(
+        DatasetError, match=r"declares 8 vertex, 6 face; the body ends early, after 194 bytes"
+    ):
+        load_object(cfg, "ball", 64, 0)
 
 
 def test_bop_model_must_match_its_published_size(data_root: Path, tmp_path: Path) -> None:

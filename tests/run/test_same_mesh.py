@@ -49,10 +49,14 @@ def test_a_rescaled_mesh_under_another_data_root_is_refused(tmp_path):
     assert first.returncode == 0, first.stderr[-2000:]
     meta = read_trial(run_dir / "trials" / MUG / "000.mcap").metadata
     assert meta["mesh_source"].endswith("google_16k/textured.obj") and len(meta["mesh_sha256"]) == 64
+    area, faces = float(meta["mesh_area_m2"]), int(meta["mesh_faces"])  # readable facts beside the hash
+    assert 0.05 < area < 0.06 and faces == 16384  # google_16k: 16k faces; the mug's 5.6 dm^2 of surface
+    assert meta["mesh_volume_m3"] == ""  # its loaded surface is open: no volume is claimed
     refused = _run(run_dir, roots["scaled"], 2)
     assert refused.returncode == 2
     lines = refused.stderr.strip().splitlines()
     assert len(lines) == 1 and f"holds trials of {MUG} made on another mesh" in lines[0], refused.stderr
+    assert f"area {area:.4g} m^2" in lines[0] and f"area {area * 1.44:.3g}" in lines[0], lines[0]
     assert not (run_dir / "trials" / MUG / "001.mcap").exists()
     again = _run(run_dir, roots["real"], 2)  # the same mesh: resumes
     assert again.returncode == 0, again.stderr[-2000:]

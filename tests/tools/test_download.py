@@ -32,6 +32,13 @@ def cube_bytes(size: float, file_type: str) -> bytes:
     return data.encode() if isinstance(data, str) else data
 
 
+def google_16k_bytes(size: float) -> bytes:
+    """An OBJ of a cylinder ``size`` across with the 16,384 faces every google_16k model has."""
+    can = trimesh.creation.cylinder(radius=size / 2, height=size, sections=4096)
+    assert len(can.faces) == 16384
+    return can.export(file_type="obj").encode()
+
+
 def write_tgz(path: Path, files: dict[str, bytes]) -> None:
     with tarfile.open(path, "w:gz") as tar:
         for name, data in files.items():
@@ -84,7 +91,7 @@ def ycb_archive(folder: Path, size: float = 0.05) -> Path:
     write_tgz(
         path,
         {
-            f"{YCB_ID}/google_16k/textured.obj": cube_bytes(size, "obj"),
+            f"{YCB_ID}/google_16k/textured.obj": google_16k_bytes(size),
             f"{YCB_ID}/google_16k/textured.mtl": b"newmtl material_0\n",
         },
     )
