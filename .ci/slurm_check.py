@@ -7,8 +7,8 @@ running cluster with a partition ``debug``; ``--cluster`` starts one first with 
 1. ``OUT/ref``: the sweep with the joblib launcher (local processes), uninterrupted.
 2. ``OUT/slurm``: the same sweep with ``hydra/launcher=submitit_slurm``; once the ``mode=bin`` task (array
    task 1) has written its first trial log, ``scancel`` ends it (submitit's job ignores the SIGTERM; the
-   cluster's KillWait of 1 s brings the SIGKILL). The submitting process must exit non-zero (submitit
-   raises UncompletedJobError for the cancelled task) and every trial finished before stays.
+   cluster's KillWait of 1 s brings the SIGKILL). The submitting process must end in one line naming the
+   task and its state, exit status 2, no traceback, and every trial finished before stays.
 3. The same command again into ``OUT/slurm`` (resume): exit 0, the trials finished before the cancel are
    read back, not re-run.
 4. ``python -m graspexp bench.compare_runs OUT/ref OUT/slurm``: every trial identical.
@@ -111,8 +111,12 @@ def cancelled_run(out: Path) -> dict[Path, int]:
     print("\n".join(output.splitlines()[-12:]))
     if not state.startswith("CANCELLED") or not 1 <= len(kept) < N_TRIALS_PER_JOB:
         fail(f"{task} was not cancelled mid-run (state {state!r}, {len(kept)} trials)")
-    if proc.returncode == 0:
-        fail("the sweep exited 0 although one of its tasks was cancelled")
+    if proc.returncode != 2:
+        fail(f"the sweep exited {proc.returncode}, not 2, although one of its tasks was cancelled")
+    errors = [ln for ln in output.splitlines() if ln.startswith("graspexp: error:")]
+    expected = f"graspexp: error: task {task} ended without a result (state CANCELLED)"
+    if "Traceback" in output or len(errors) != 1 or not errors[0].startswith(expected):
+        fail(f"the submitter did not end in one line starting {expected!r}:\n{output[-3000:]}")
     return kept
 
 

@@ -123,6 +123,14 @@ _SWEEP_LOCKS: dict[str, DirectoryLock] = {}
 """The sweep locks this process holds, by sweep directory (not on the callback: joblib pickles it)."""
 
 
+def release_sweep_locks(sweep_dir: str | None = None) -> None:
+    """Release this process's lock of ``sweep_dir`` (None: of every sweep it holds): the sweep ends."""
+    for held in [str(sweep_dir)] if sweep_dir is not None else list(_SWEEP_LOCKS):
+        lock = _SWEEP_LOCKS.pop(held, None)
+        if lock is not None:
+            lock.release()
+
+
 class SweepReport(Callback):
     """Hydra callback (``hydra.callbacks`` in ``conf/config.yaml``): checks the output folder before Hydra
     writes into it, and ends a multirun with the summary of the jobs that could not run."""
@@ -149,9 +157,7 @@ class SweepReport(Callback):
         self._started = time.perf_counter()
 
     def on_multirun_end(self, config: DictConfig, **kwargs: Any) -> None:
-        lock = _SWEEP_LOCKS.pop(str(config.hydra.sweep.dir), None)
-        if lock is not None:
-            lock.release()
+        release_sweep_locks(config.hydra.sweep.dir)
         wall = time.perf_counter() - getattr(self, "_started", time.perf_counter())
         print(f"\ngraspexp: sweep {config.hydra.sweep.dir} done in {wall:.1f} s wall", file=sys.stderr)
         folder = Path(config.hydra.sweep.dir) / FAILED_DIR / os.environ.get(SWEEP_ID_ENV, "unknown")

@@ -23,6 +23,7 @@ from omegaconf import DictConfig
 from graspexp.config import ConfigError
 from graspexp.config.compose import compose_validated, expand_sweeps, one_line, search_ranges
 from graspexp.config.registry import group_options
+from graspexp.run.launchers import submitit_guard
 from graspexp.tools import TOOLS
 
 OVERRIDES_HELP = "Hydra overrides of conf/config.yaml, e.g. dataset=ycb mode=bin planner.m=128"
@@ -194,4 +195,5 @@ def run_checked(hydra_main: Callable[[], object], argv: list[str] | None = None)
         return
     if not (args.hydra_help or args.info):
         check_overrides(args.overrides, multirun=args.multirun)
-    hydra_main()
+    with submitit_guard(args.overrides if args.multirun else ()):
+        hydra_main()
