@@ -1,2 +1,2 @@
 """Base modules every stage may import, and that import no stage: geometry (frames, rotations), seeding
-(derived seeds), outcome (a trial's result and failure reasons) and bodies (the scene's body names)."""
+(derived seeds), outcome (a trial's result and failure reasons), bodies (the scene's body names) and files (atomic writes)."""

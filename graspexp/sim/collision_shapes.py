@@ -20,7 +20,6 @@ import json
 import logging
 import os
 import sys
-import tempfile
 from contextlib import contextmanager
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
@@ -30,6 +29,7 @@ import trimesh
 from omegaconf import OmegaConf
 
 from graspexp.config import SimConfig
+from graspexp.core.files import write_atomic
 from graspexp.sim.collision_accuracy import shape_accuracy, surface_points
 from graspexp.sim.shape import CollisionShape
 
@@ -142,7 +142,7 @@ def collision_shape(mesh: trimesh.Trimesh, cfg: SimConfig) -> CollisionShape:
         obj_text = b"" if convex else _obj_text(parts[0])
         arrays = {f"{kind}_{i}": a for i, (v, f) in enumerate(parts) for kind, a in (("v", v), ("f", f))}
         digests = {"sha256": _parts_digest(convex, parts), "obj_sha256": hashlib.sha256(obj_text).hexdigest()}
-        _write_atomic(path, lambda fh: np.savez(fh, convex=convex, n_parts=len(parts), **digests, **arrays))
+        write_atomic(path, lambda fh: np.savez(fh, convex=convex, n_parts=len(parts), **digests, **arrays))
         entry = (convex, tuple(parts), digests["obj_sha256"])
     convex, parts, obj_sha256 = entry
     if convex:
@@ -152,7 +152,7 @@ def collision_shape(mesh: trimesh.Trimesh, cfg: SimConfig) -> CollisionShape:
         if obj.exists():
             log.warning("collision cache file %s does not match its checksum; rewriting it", obj)
         text = _obj_text(parts[0])
-        _write_atomic(obj, lambda fh: fh.write(text))
+        write_atomic(obj, lambda fh: fh.write(text))
     return CollisionShape(params["method"], parts, False, obj, key=key)
 
 
@@ -302,15 +302,6 @@ def _quiet_stdio():
         os.dup2(saved[1], 2)
         for fd in (*saved, devnull):
             os.close(fd)
-
-
-def _write_atomic(path: Path, write) -> None:
-    """Write ``path`` through a temporary file in the same folder (readers never see a partial file)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=path.suffix + ".partial")
-    with os.fdopen(fd, "wb") as fh:
-        write(fh)
-    os.replace(tmp, path)
 
 
 def hull_meshes(shape: CollisionShape) -> list[trimesh.Trimesh]:

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 from omegaconf import DictConfig
 
+from graspexp.core.files import write_atomic
 from graspexp.datasets import DatasetError, job_object
 from graspexp.planning import NoFeasibleGrasp, UnknownPlanner
 from graspexp.run.upright import PlannedObject, plan_upright
@@ -58,10 +59,7 @@ def dump(path: str, planned: PlannedObject) -> None:
     """Save every intermediate of the plan to ``path`` (``.npz``)."""
     arrays = {key: np.asarray(value) for key, value in planned.result.details.items()}
     arrays["object_pose"] = planned.object_pose
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    with target.open("wb") as fh:
-        np.savez(fh, **arrays)
+    write_atomic(Path(path), lambda fh: np.savez(fh, **arrays))
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -78,7 +76,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (DatasetError, NoFeasibleGrasp, UnknownPlanner) as err:
         fail(f"{name}: {err}" if not isinstance(err, DatasetError) else str(err), PROG)
     if args.dump:
-        dump(args.dump, planned)
+        try:
+            dump(args.dump, planned)
+        except OSError as err:
+            fail(f"cannot write {args.dump}: {err.strerror or err}; choose another path for --dump", PROG)
     print(json.dumps(grasp_record(cfg, planned)))
     return 0
 
