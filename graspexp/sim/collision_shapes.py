@@ -185,18 +185,36 @@ def _read_entry(path: Path) -> tuple[bool, tuple, str] | None:
 def shape_with_fallback(mesh: trimesh.Trimesh, cfg: SimConfig) -> tuple[CollisionShape, str]:
     """(shape, note): :func:`collision_shape` under ``cfg``; a mesh that ``mesh`` cannot repair (an open
     low-poly CAD export, say) gets :data:`FALLBACK_METHOD` instead, and the note says so with the measured
-    accuracy of the shape it got ("" when the configured method worked)."""
-    try:
-        return collision_shape(mesh, cfg), ""
-    except RepairError as err:
-        why = str(err).split(";")[0]
+    accuracy of the shape it got ("" when the configured method worked). The failed repair and the note
+    are cached beside the shapes (``<key>.fallback.json``, the configured method's key), so later jobs
+    neither repeat the repair nor measure again."""
+    record = cache_dir(cfg) / f"{mesh_key(mesh, shape_params(cfg))}.fallback.json"
+    note = _read_fallback(record)
+    if note is None:
+        try:
+            return collision_shape(mesh, cfg), ""
+        except RepairError as err:
+            why = str(err).split(";")[0]
     shape = collision_shape(mesh, _with_method(cfg, FALLBACK_METHOD))
-    acc = shape_accuracy(surface_points(shape, 2000, rng=np.random.default_rng(0)), mesh)
-    return shape, (
-        f"collision: {FALLBACK_METHOD} (fallback: sim.collision_method={cfg.collision_method} failed: "
-        f"{why}); its surface lies outside the mesh by {acc.outside_p50_mm:.2f} mm median, "
-        f"{acc.outside_p90_mm:.2f} mm p90, {acc.outside_max_mm:.2f} mm max"
-    )
+    if note is None:
+        acc = shape_accuracy(surface_points(shape, 2000, rng=np.random.default_rng(0)), mesh)
+        note = (
+            f"collision: {FALLBACK_METHOD} (fallback: sim.collision_method={cfg.collision_method} failed: "
+            f"{why}); its surface lies outside the mesh by {acc.outside_p50_mm:.2f} mm median, "
+            f"{acc.outside_p90_mm:.2f} mm p90, {acc.outside_max_mm:.2f} mm max"
+        )
+        text = json.dumps({"note": note}).encode()
+        write_atomic(record, lambda fh: fh.write(text))
+    return shape, note
+
+
+def _read_fallback(path: Path) -> str | None:
+    """The note of a cached fallback record; None when absent or unreadable (the repair is tried again)."""
+    try:
+        note = json.loads(path.read_text())["note"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    return note if isinstance(note, str) and note.startswith("collision: ") else None
 
 
 def _with_method(cfg: SimConfig, method: str) -> SimConfig:

@@ -216,3 +216,29 @@ def test_the_cache_key_holds_the_library_versions(monkeypatch):
     key = collision_shapes.mesh_key(mesh, params)
     monkeypatch.setattr(collision_shapes, "_library_versions", lambda method: {"pymeshfix": "99"})
     assert collision_shapes.mesh_key(mesh, params) != key
+
+
+def test_an_unrepairable_mesh_falls_back_once_then_reads_its_note_from_the_cache(tmp_path, monkeypatch):
+    from graspexp.sim import collision_shapes
+
+    cross = np.array(
+        [[-4, 0, 0], [4, 0, 0], [4, 0, 10], [-4, 0, 10], [0, -4, 0], [0, 4, 0], [0, 4, 10], [0, -4, 10]]
+    )
+    mesh = trimesh.Trimesh(cross / 100.0, [[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])  # two crossed sheets
+    cfg = SimConfig(cache_dir=str(tmp_path), collision_method="mesh")
+    shape, note = collision_shapes.shape_with_fallback(mesh, cfg)
+    assert shape.method == "coacd" and note.startswith(
+        "collision: coacd (fallback: sim.collision_method=mesh"
+    )
+    assert len(list(tmp_path.rglob("*.fallback.json"))) == 1
+
+    def no_repair(*args, **kwargs):
+        raise AssertionError("the failed repair was tried again")
+
+    monkeypatch.setattr(collision_shapes, "_closed_mesh", no_repair)
+    monkeypatch.setattr(collision_shapes, "shape_accuracy", no_repair)
+    again, again_note = collision_shapes.shape_with_fallback(mesh, cfg)
+    assert again_note == note and again.key == shape.key
+    next(tmp_path.rglob("*.fallback.json")).write_text("{")  # a damaged record: the repair is tried again
+    with pytest.raises(AssertionError, match="tried again"):
+        collision_shapes.shape_with_fallback(mesh, cfg)
