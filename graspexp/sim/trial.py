@@ -166,7 +166,9 @@ class _Sim:
         continues after the earlier drops' (one clock per log, so a reader's time order is the trial's)."""
         self.log_every = max(1, round(1.0 / (cfg.sim.log_rate_hz * self.dt)))
         self.gripper: Gripper | None = None
-        self._links: list | None = None
+        self._pack_poses = ts.scene.pack_poses
+        self._frame_rows: list[tuple[str, int]] = []
+        self._n_entities = -1
         self.touch: SupportTouch | None = None
         self.touched_support = False
         self.max_speed_sq = float(cfg.sim.max_speed_mps) ** 2
@@ -239,17 +241,24 @@ class _Sim:
         finally:
             self.timings["physics"] += physics
 
-    def frames(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-        """World poses (position (3,) m, quaternion wxyz (4,)) of the logged frames."""
-        p = self.ts.object_entity.pose
-        out = {"object": (p.p, p.q)}
+    def frames(self) -> dict[str, tuple[list[float], list[float]]]:
+        """World poses (position (3,) m, quaternion wxyz (4,)) of the logged frames, read in one call:
+        ``Scene.pack_poses`` gives every entity's pose in the scene's entity order, 7 float32 each
+        (quaternion wxyz, then position)."""
+        rows = np.frombuffer(self._pack_poses(), dtype=np.float32).reshape(-1, 7)
+        if len(rows) != self._n_entities:  # the gripper was added or the support removed
+            self._frame_rows = self._find_frames()
+            self._n_entities = len(rows)
+        rows = rows.tolist()
+        return {name: (rows[i][4:], rows[i][:4]) for name, i in self._frame_rows}
+
+    def _find_frames(self) -> list[tuple[str, int]]:
+        """(frame name, index in the scene's entity list) of the object and the gripper links."""
+        logged = [("object", self.ts.object_entity)]
         if self.gripper is not None:
-            if self._links is None:
-                self._links = [(link.name, link) for link in (self.gripper.palm, *self.gripper.fingers)]
-            for name, link in self._links:
-                lp = link.entity_pose
-                out[name] = (lp.p, lp.q)
-        return out
+            logged += [(link.name, link.entity) for link in (self.gripper.palm, *self.gripper.fingers)]
+        index = {e.global_id: i for i, e in enumerate(self.ts.scene.entities)}
+        return [(name, index[e.global_id]) for name, e in logged]
 
     @property
     def log_t(self) -> float:
