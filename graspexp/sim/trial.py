@@ -142,6 +142,13 @@ def perceived_pose(
     return out
 
 
+F32_DOT_REL_ERROR = 1e-6
+"""Bound on the relative difference between numpy's float32 ``v.dot(v)`` of a float32 3-vector (products
+and sums rounded to float32, or summed in float64, then rounded) and the float64 sum of squares of the same
+components (at most about 4 x 2^-24 = 2.4e-7 for nonnegative terms). A float64 sum below a limit by more than
+this is below it in float32 too, so only a speed near a limit needs the float32 products."""
+
+
 class _Sim:
     """Steps one trial's scene, keeps sim time, checks stability and table touches, logs at a fixed rate.
 
@@ -167,7 +174,7 @@ class _Sim:
         self.log_every = max(1, round(1.0 / (cfg.sim.log_rate_hz * self.dt)))
         self.gripper: Gripper | None = None
         self._pack_poses = ts.scene.pack_poses
-        self._frame_rows: list[tuple[str, int]] = []
+        self._frame_rows: tuple[list[str], list[int]] = ([], [])
         self._n_entities = -1
         self.touch: SupportTouch | None = None
         self.touched_support = False
@@ -179,13 +186,23 @@ class _Sim:
         self._contacts = ts.scene.physx_system.get_contacts
         body = ts.object_body
         self._velocities = (body.get_linear_velocity, body.get_angular_velocity)
-        self.speed_sq = (0.0, 0.0)
-        """The object's squared linear (m^2/s^2) and angular (rad^2/s^2) speed after the last step."""
+        self._last_velocities: tuple[np.ndarray, np.ndarray] | None = None
+        self._surely_v = self.max_speed_sq * (1.0 - F32_DOT_REL_ERROR)
+        self._surely_w = self.max_angular_speed_sq * (1.0 - F32_DOT_REL_ERROR)
 
     def watch_support(self, gripper: Gripper) -> None:
         """From now on a gripper link touching the support fails the trial (COLLISION_SUPPORT)."""
         support = self.ts.support.find_component_by_type(sapien.physx.PhysxRigidStaticComponent)
         self.touch = SupportTouch(support, [gripper.palm, *gripper.fingers])
+
+    @property
+    def speed_sq(self) -> tuple[float, float]:
+        """The object's squared linear (m^2/s^2) and angular (rad^2/s^2) speed after the last step (float32
+        dot products of the velocities PhysX reports); (0, 0) before the first step."""
+        if self._last_velocities is None:
+            return 0.0, 0.0
+        v, w = self._last_velocities
+        return v.dot(v), w.dot(w)
 
     @property
     def t(self) -> float:
@@ -210,7 +227,7 @@ class _Sim:
         this is the loop every physics step of a trial goes through."""
         perf, physx_step, contacts, touch = time.perf_counter, self._physx_step, self._contacts, self.touch
         linear, angular = self._velocities
-        max_v, max_w = self.max_speed_sq, self.max_angular_speed_sq
+        surely_v, surely_w = self._surely_v, self._surely_w
         physics = 0.0
         try:
             for i in range(n):
@@ -221,13 +238,11 @@ class _Sim:
                 physx_step()
                 physics += perf() - t0
                 self.steps += 1
-                v, w = linear(), angular()
-                vv, ww = self.speed_sq = v.dot(v), w.dot(w)
-                if not (vv <= max_v and ww < max_w):  # NaN fails every comparison
-                    raise TrialFailed(
-                        FailureReason.SIM_UNSTABLE,
-                        f"object speed {float(vv) ** 0.5:.3g} m/s at t={self.t:.3f} s",
-                    )
+                v, w = self._last_velocities = linear(), angular()
+                x, y, z = v.tolist()
+                a, b, c = w.tolist()
+                if not (x * x + y * y + z * z <= surely_v and a * a + b * b + c * c < surely_w):
+                    self._check_speed()  # near a limit, or past it, or NaN: the float32 check decides
                 if touch is not None and touch(contacts()):
                     self.touched_support = True
                     if self.recording:
@@ -241,16 +256,25 @@ class _Sim:
         finally:
             self.timings["physics"] += physics
 
+    def _check_speed(self) -> None:
+        """Raise SIM_UNSTABLE when the object moves or spins faster than the limits (NaN fails too)."""
+        vv, ww = self.speed_sq
+        if not (vv <= self.max_speed_sq and ww < self.max_angular_speed_sq):  # NaN fails every comparison
+            raise TrialFailed(
+                FailureReason.SIM_UNSTABLE, f"object speed {float(vv) ** 0.5:.3g} m/s at t={self.t:.3f} s"
+            )
+
     def frames(self) -> dict[str, tuple[list[float], list[float]]]:
         """World poses (position (3,) m, quaternion wxyz (4,)) of the logged frames, read in one call:
         ``Scene.pack_poses`` gives every entity's pose in the scene's entity order, 7 float32 each
         (quaternion wxyz, then position)."""
-        rows = np.frombuffer(self._pack_poses(), dtype=np.float32).reshape(-1, 7)
-        if len(rows) != self._n_entities:  # the gripper was added or the support removed
-            self._frame_rows = self._find_frames()
-            self._n_entities = len(rows)
-        rows = rows.tolist()
-        return {name: (rows[i][4:], rows[i][:4]) for name, i in self._frame_rows}
+        poses = np.frombuffer(self._pack_poses(), dtype=np.float32).reshape(-1, 7)
+        if len(poses) != self._n_entities:  # the gripper was added or the support removed
+            names, rows = zip(*self._find_frames(), strict=True)
+            self._frame_rows = list(names), list(rows)
+            self._n_entities = len(poses)
+        names, rows = self._frame_rows
+        return {name: (pose[4:], pose[:4]) for name, pose in zip(names, poses[rows].tolist(), strict=True)}
 
     def _find_frames(self) -> list[tuple[str, int]]:
         """(frame name, index in the scene's entity list) of the object and the gripper links."""
