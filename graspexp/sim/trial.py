@@ -324,7 +324,8 @@ def _settle(sim: _Sim) -> tuple[bool, bool]:
         sim.step()
         if body.get_entity_pose().p[2] < below_z:
             return False, False
-        still = still + 1 if sim.speed_sq[0] < linear_sq and sim.speed_sq[1] < angular_sq else 0
+        vv, ww = sim.speed_sq
+        still = still + 1 if vv < linear_sq and ww < angular_sq else 0
         if sim.steps >= min_steps and still >= hold_steps:
             return _on_support(sim.ts, sim.cfg), True
     return _on_support(sim.ts, sim.cfg), False
