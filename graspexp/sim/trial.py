@@ -173,9 +173,7 @@ class _Sim:
         continues after the earlier drops' (one clock per log, so a reader's time order is the trial's)."""
         self.log_every = max(1, round(1.0 / (cfg.sim.log_rate_hz * self.dt)))
         self.gripper: Gripper | None = None
-        self._pack_poses = ts.scene.pack_poses
-        self._frame_rows: tuple[list[str], list[int]] = ([], [])
-        self._n_entities = -1
+        self._links: list | None = None
         self.touch: SupportTouch | None = None
         self.touched_support = False
         self.max_speed_sq = float(cfg.sim.max_speed_mps) ** 2
@@ -264,25 +262,17 @@ class _Sim:
                 FailureReason.SIM_UNSTABLE, f"object speed {float(vv) ** 0.5:.3g} m/s at t={self.t:.3f} s"
             )
 
-    def frames(self) -> dict[str, tuple[list[float], list[float]]]:
-        """World poses (position (3,) m, quaternion wxyz (4,)) of the logged frames, read in one call:
-        ``Scene.pack_poses`` gives every entity's pose in the scene's entity order, 7 float32 each
-        (quaternion wxyz, then position)."""
-        poses = np.frombuffer(self._pack_poses(), dtype=np.float32).reshape(-1, 7)
-        if len(poses) != self._n_entities:  # the gripper was added or the support removed
-            names, rows = zip(*self._find_frames(), strict=True)
-            self._frame_rows = list(names), list(rows)
-            self._n_entities = len(poses)
-        names, rows = self._frame_rows
-        return {name: (pose[4:], pose[:4]) for name, pose in zip(names, poses[rows].tolist(), strict=True)}
-
-    def _find_frames(self) -> list[tuple[str, int]]:
-        """(frame name, index in the scene's entity list) of the object and the gripper links."""
-        logged = [("object", self.ts.object_entity)]
+    def frames(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """World poses (position (3,) m, quaternion wxyz (4,)) of the logged frames."""
+        p = self.ts.object_entity.pose
+        out = {"object": (p.p, p.q)}
         if self.gripper is not None:
-            logged += [(link.name, link.entity) for link in (self.gripper.palm, *self.gripper.fingers)]
-        index = {e.global_id: i for i, e in enumerate(self.ts.scene.entities)}
-        return [(name, index[e.global_id]) for name, e in logged]
+            if self._links is None:
+                self._links = [(link.name, link) for link in (self.gripper.palm, *self.gripper.fingers)]
+            for name, link in self._links:
+                lp = link.entity_pose
+                out[name] = (lp.p, lp.q)
+        return out
 
     @property
     def log_t(self) -> float:
