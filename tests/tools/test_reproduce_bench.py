@@ -1,5 +1,7 @@
 """bench.reproduce: the paper suite with the paper's planner, its overrides, and a tiny run's printout."""
 
+import pytest
+
 from graspexp.tools.bench.reproduce import main, sweep_overrides
 
 
@@ -14,6 +16,8 @@ def test_the_sweep_is_the_paper_suite_with_the_papers_planner_logged_and_overrid
     assert {"trials=1", "dataset=ycb", "objects=[011_banana]", "planner=optimal"} <= set(subset)
 
 
+@pytest.mark.slow
+@pytest.mark.sim
 def test_a_tiny_subset_prints_wall_cpu_and_rate_for_one_and_two_workers(capsys):
     main(["dataset=ycb", "objects=[011_banana]", "mode=collab", "rot=z", "trials=1"])
     out = capsys.readouterr().out
