@@ -153,8 +153,9 @@ class _Sim:
     """Steps one trial's scene, keeps sim time, checks stability and table touches, logs at a fixed rate.
 
     Between log ticks a step does only the physics step, the arm's drive targets computed before the run
-    (:meth:`run`), the object's speed check (two velocity reads and two dot products) and, while
-    :meth:`watch_support` is on, the gripper-support contact check.
+    (:meth:`run`), the object's speed check (two velocity reads; numpy's float32 dot products only near a
+    limit, see :data:`F32_DOT_REL_ERROR`) and, while :meth:`watch_support` is on, the gripper-support
+    contact check.
     """
 
     def __init__(
@@ -215,6 +216,7 @@ class _Sim:
         self.steps_n(n, moves)
 
     def step(self) -> None:
+        """One physics step with its checks (:meth:`steps_n`)."""
         self.steps_n(1)
 
     def steps_n(self, n: int, moves: list | None = None) -> None:
