@@ -77,12 +77,14 @@ def contact_records(contacts: list, dt: float) -> list[dict]:
     for c in contacts:
         w_sum = px = py = pz = nx = ny = nz = fx = fy = fz = 0.0
         sep = math.inf
-        for p in c.points:
-            sep = min(sep, p.separation)
+        for p in c.points:  # most points are proximity reports: their position and normal are not read
+            s = p.separation
+            if s < sep:
+                sep = s
             ix, iy, iz = p.impulse.tolist()
-            w = math.sqrt(ix * ix + iy * iy + iz * iz)
-            if w == 0.0:
+            if ix == 0.0 and iy == 0.0 and iz == 0.0:
                 continue
+            w = math.sqrt(ix * ix + iy * iy + iz * iz)
             x, y, z = p.position.tolist()
             a, b, d = p.normal.tolist()
             w_sum += w

@@ -11,6 +11,7 @@ palm and fingers carry its boxes; a URDF gripper's carry its convex collision pi
 """
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -53,13 +54,26 @@ class Gripper:
         self.drive_fingers(half_width_m)
 
     def drive_arm(self, offset: np.ndarray) -> None:
-        """Position targets of the x, y, z joints: TCP offset (3,) in the grasp frame, metres. The step loop
-        calls this every step, so a joint whose target is unchanged is left alone."""
-        targets = np.asarray(offset, dtype=float).tolist()
-        for i, (joint, value) in enumerate(zip(self.joints[:3], targets, strict=True)):
-            if value != self.arm_targets[i]:
-                joint.set_drive_target(value)
-                self.arm_targets[i] = value
+        """Position targets of the x, y, z joints: TCP offset (3,) in the grasp frame, metres; a joint whose
+        target is unchanged is left alone."""
+        for set_target, value in self.arm_moves(np.reshape(offset, (1, 3)))[0]:
+            set_target(value)
+
+    def arm_moves(self, offsets: np.ndarray) -> list[list[tuple[Callable[[float], None], float]]]:
+        """The x, y, z drive-target changes that move the TCP through ``offsets`` ((n, 3) in the grasp frame,
+        m), one list per step of (setter, target): a joint whose target is unchanged since the step before (or
+        since the last move) is left alone. Computed before stepping; :attr:`arm_targets` becomes the last row."""
+        setters = [joint.set_drive_target for joint in self.joints[:3]]
+        last = self.arm_targets
+        moves = []
+        for row in np.asarray(offsets, dtype=float).tolist():
+            changed = []
+            for i, value in enumerate(row):
+                if value != last[i]:
+                    changed.append((setters[i], value))
+                    last[i] = value
+            moves.append(changed)
+        return moves
 
     def drive_fingers(self, half_width_m: float) -> None:
         for joint in self.joints[N_BASE:]:

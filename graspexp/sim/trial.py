@@ -142,11 +142,20 @@ def perceived_pose(
     return out
 
 
+F32_DOT_REL_ERROR = 1e-6
+"""Bound on the relative difference between numpy's float32 ``v.dot(v)`` of a float32 3-vector (products
+and sums rounded to float32, or summed in float64, then rounded) and the float64 sum of squares of the same
+components (at most about 4 x 2^-24 = 2.4e-7 for nonnegative terms). A float64 sum below a limit by more than
+this is below it in float32 too, so only a speed near a limit needs the float32 products."""
+
+
 class _Sim:
     """Steps one trial's scene, keeps sim time, checks stability and table touches, logs at a fixed rate.
 
-    Between log ticks a step does only the physics step, the object's speed check (two velocity reads and
-    two dot products) and, while :meth:`watch_support` is on, the gripper-support contact check.
+    Between log ticks a step does only the physics step, the arm's drive targets computed before the run
+    (:meth:`run`), the object's speed check (two velocity reads; numpy's float32 dot products only near a
+    limit, see :data:`F32_DOT_REL_ERROR`) and, while :meth:`watch_support` is on, the gripper-support
+    contact check.
     """
 
     def __init__(
@@ -159,7 +168,7 @@ class _Sim:
     ):
         self.ts, self.cfg, self.rec, self.timings = ts, cfg, recorder, timings
         self.dt = float(cfg.sim.timestep_s)
-        self.t, self.steps = 0.0, 0
+        self.steps = 0
         self.log_offset_s = log_offset_s
         """Added to the sim time of everything logged: a re-drop's scene starts at t = 0 again, and its log
         continues after the earlier drops' (one clock per log, so a reader's time order is the trial's)."""
@@ -176,44 +185,84 @@ class _Sim:
         self._contacts = ts.scene.physx_system.get_contacts
         body = ts.object_body
         self._velocities = (body.get_linear_velocity, body.get_angular_velocity)
-        self.speed_sq = (0.0, 0.0)
-        """The object's squared linear (m^2/s^2) and angular (rad^2/s^2) speed after the last step."""
+        self._last_velocities: tuple[np.ndarray, np.ndarray] | None = None
+        self._surely_v = self.max_speed_sq * (1.0 - F32_DOT_REL_ERROR)
+        self._surely_w = self.max_angular_speed_sq * (1.0 - F32_DOT_REL_ERROR)
 
     def watch_support(self, gripper: Gripper) -> None:
         """From now on a gripper link touching the support fails the trial (COLLISION_SUPPORT)."""
         support = self.ts.support.find_component_by_type(sapien.physx.PhysxRigidStaticComponent)
         self.touch = SupportTouch(support, [gripper.palm, *gripper.fingers])
 
-    def run(self, seconds: float, each_step=None) -> None:
+    @property
+    def speed_sq(self) -> tuple[float, float]:
+        """The object's squared linear (m^2/s^2) and angular (rad^2/s^2) speed after the last step (float32
+        dot products of the velocities PhysX reports); (0, 0) before the first step."""
+        if self._last_velocities is None:
+            return 0.0, 0.0
+        v, w = self._last_velocities
+        return v.dot(v), w.dot(w)
+
+    @property
+    def t(self) -> float:
+        """Sim time of the scene, s (steps x dt)."""
+        return self.steps * self.dt
+
+    def run(self, seconds: float, arm: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
+        """Step for ``seconds`` of sim time. ``arm``: step fractions s (n,) = (i + 1) / n -> the gripper's TCP
+        offsets (n, 3) in the grasp frame, m; each is driven before its step (all computed before stepping)."""
         n = max(1, int(round(seconds / self.dt)))
-        for i in range(n):
-            if each_step is not None:
-                each_step((i + 1) / n)
-            self.step()
+        moves = None if arm is None else self.gripper.arm_moves(arm(np.arange(1, n + 1) / n))
+        self.steps_n(n, moves)
 
     def step(self) -> None:
-        t0 = time.perf_counter()
-        self._physx_step()
-        self.timings["physics"] += time.perf_counter() - t0
-        self.steps += 1
-        self.t = self.steps * self.dt
+        """One physics step with its checks (:meth:`steps_n`)."""
+        self.steps_n(1)
+
+    def steps_n(self, n: int, moves: list | None = None) -> None:
+        """Take ``n`` physics steps; ``moves[i]``: the (drive-target setter, value) pairs applied before step i.
+
+        After each step: the object's speed check, the gripper-support check while :meth:`watch_support` is
+        on, and a log tick every ``log_every`` steps while recording. The bound methods and limits are locals:
+        this is the loop every physics step of a trial goes through."""
+        perf, physx_step, contacts, touch = time.perf_counter, self._physx_step, self._contacts, self.touch
         linear, angular = self._velocities
-        v, w = linear(), angular()
-        vv, ww = self.speed_sq = v.dot(v), w.dot(w)
+        surely_v, surely_w = self._surely_v, self._surely_w
+        physics = 0.0
+        try:
+            for i in range(n):
+                if moves is not None:
+                    for set_target, value in moves[i]:
+                        set_target(value)
+                t0 = perf()
+                physx_step()
+                physics += perf() - t0
+                self.steps += 1
+                v, w = self._last_velocities = linear(), angular()
+                x, y, z = v.tolist()
+                a, b, c = w.tolist()
+                if not (x * x + y * y + z * z <= surely_v and a * a + b * b + c * c < surely_w):
+                    self._check_speed()  # near a limit, or past it, or NaN: the float32 check decides
+                if touch is not None and touch(contacts()):
+                    self.touched_support = True
+                    if self.recording:
+                        self.log()
+                    raise TrialFailed(
+                        FailureReason.COLLISION_SUPPORT, f"gripper touched the support at t={self.t:.3f} s"
+                    )
+                if self.steps == self._next_log:
+                    self._next_log += self.log_every
+                    self.log()
+        finally:
+            self.timings["physics"] += physics
+
+    def _check_speed(self) -> None:
+        """Raise SIM_UNSTABLE when the object moves or spins faster than the limits (NaN fails too)."""
+        vv, ww = self.speed_sq
         if not (vv <= self.max_speed_sq and ww < self.max_angular_speed_sq):  # NaN fails every comparison
             raise TrialFailed(
                 FailureReason.SIM_UNSTABLE, f"object speed {float(vv) ** 0.5:.3g} m/s at t={self.t:.3f} s"
             )
-        if self.touch is not None and self.touch(self._contacts()):
-            self.touched_support = True
-            if self.recording:
-                self.log()
-            raise TrialFailed(
-                FailureReason.COLLISION_SUPPORT, f"gripper touched the support at t={self.t:.3f} s"
-            )
-        if self.steps == self._next_log:
-            self._next_log += self.log_every
-            self.log()
 
     def frames(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """World poses (position (3,) m, quaternion wxyz (4,)) of the logged frames."""
@@ -267,7 +316,8 @@ def _settle(sim: _Sim) -> tuple[bool, bool]:
         sim.step()
         if body.get_entity_pose().p[2] < below_z:
             return False, False
-        still = still + 1 if sim.speed_sq[0] < linear_sq and sim.speed_sq[1] < angular_sq else 0
+        vv, ww = sim.speed_sq
+        still = still + 1 if vv < linear_sq and ww < angular_sq else 0
         if sim.steps >= min_steps and still >= hold_steps:
             return _on_support(sim.ts, sim.cfg), True
     return _on_support(sim.ts, sim.cfg), False
@@ -429,6 +479,11 @@ def _grasp_point_on_object(gripper: Gripper, ts: TrialScene) -> np.ndarray:
     return (np.linalg.inv(ts.object_pose()) @ gripper.tcp_pose())[:3, 3]
 
 
+def _along_z(z: np.ndarray) -> np.ndarray:
+    """(n, 3) TCP offsets (0, 0, z) in the grasp frame from z (n,), m."""
+    return np.stack([np.zeros_like(z), np.zeros_like(z), z], axis=1)
+
+
 def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> None:
     cfg = ctx.cfg
     mode, scfg = cfg.mode, cfg.sim
@@ -444,10 +499,7 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
     gripper.set_state(np.array([0.0, 0.0, -standoff]), half)
 
     sim.phase("approach", {"standoff_m": standoff, "width_m": grasp.width_m})
-    sim.run(
-        standoff / scfg.approach_speed_mps,
-        lambda s: gripper.drive_arm(np.array([0.0, 0.0, -standoff * (1 - s)])),
-    )
+    sim.run(standoff / scfg.approach_speed_mps, lambda s: _along_z(-standoff * (1 - s)))
     if scfg.approach_settle_s > 0:
         sim.phase("settle_arm", {"duration_s": scfg.approach_settle_s})
         sim.run(scfg.approach_settle_s)  # the arm reaches the grasp pose before the fingers close
@@ -467,15 +519,12 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
         ctx.recorder.delete_entities(sim.log_t, [SUPPORT_NAME])
     if mode.pull_back_m > 0:
         sim.phase("pull_back", {"distance_m": mode.pull_back_m})
-        sim.run(
-            mode.pull_back_m / scfg.retract_speed_mps,
-            lambda s: gripper.drive_arm(np.array([0, 0, -mode.pull_back_m * s])),
-        )
+        sim.run(mode.pull_back_m / scfg.retract_speed_mps, lambda s: _along_z(-mode.pull_back_m * s))
     if mode.lift_m > 0:
         sim.phase("lift", {"distance_m": mode.lift_m})
         start = np.array([0.0, 0.0, -mode.pull_back_m])
         up = grasp.pose[:3, :3].T @ np.array([0.0, 0.0, mode.lift_m])
-        sim.run(mode.lift_m / scfg.retract_speed_mps, lambda s: gripper.drive_arm(start + s * up))
+        sim.run(mode.lift_m / scfg.retract_speed_mps, lambda s: start + s[:, None] * up)
     sim.phase("hold", {"duration_s": mode.hold_s})
     sim.run(mode.hold_s)
     forces = _held(sim, grasp)

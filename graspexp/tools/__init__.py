@@ -15,6 +15,7 @@ TOOLS: tuple[str, ...] = (
     "config_reference",
     "tune",
     "bench.trials",
+    "bench.reproduce",
     "bench.plan_latency",
     "bench.collision_shapes",
     "bench.shortlist",
