@@ -302,10 +302,76 @@ def slab_spans(
     return out
 
 
+SLACK_M = 1e-9
+"""Added to a cull's bound, m: far above the rounding of coordinates below a kilometre, so a point culled
+by :func:`_near_plane` fails the exact test too."""
+
+
+@_jit
+def _soa(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The (N, 3) points as three contiguous (N,) coordinate arrays (structure of arrays: loops vectorise)."""
+    return (
+        np.ascontiguousarray(points[:, 0]),
+        np.ascontiguousarray(points[:, 1]),
+        np.ascontiguousarray(points[:, 2]),
+    )
+
+
+@_jit
+def _rotation_run(rotations: np.ndarray, origins: np.ndarray, b: int) -> tuple[int, float]:
+    """End (exclusive) of the run of frames from ``b`` whose (3, 3) rotation is bitwise ``rotations[b]``,
+    and the largest distance of their origins (B, 3) from ``origins[b]`` along that rotation's X axis, m:
+    the frames of one path and roll, moved along their Y and Z axes only, share one cull."""
+    r, o = rotations[b], origins[b]
+    end, shift = b + 1, 0.0
+    while end < rotations.shape[0]:
+        q = rotations[end]
+        same = True
+        for i in range(3):
+            for j in range(3):
+                same = same and q[i, j] == r[i, j]
+        if not same:
+            break
+        d = origins[end]
+        shift = max(shift, abs(r[0, 0] * (d[0] - o[0]) + r[1, 0] * (d[1] - o[1]) + r[2, 0] * (d[2] - o[2])))
+        end += 1
+    return end, shift
+
+
+@_jit
+def _near_plane(
+    xs: np.ndarray,
+    ys: np.ndarray,
+    zs: np.ndarray,
+    r: np.ndarray,
+    o: np.ndarray,
+    limit: float,
+    keep: np.ndarray,
+    cull: np.ndarray,
+    idx: np.ndarray,
+) -> int:
+    """Copy the points (coordinate arrays, world) with ``|x| <= limit`` in the frame of the (3, 3)
+    rotation ``r`` at the origin ``o`` into the rows of ``cull`` (3, N) and their indices, ascending, into
+    ``idx``; return their count. ``keep`` (N,) bool is scratch. A frame with the same rotation whose origin
+    lies ``s`` from ``o`` along X sees no other point within ``limit - s - SLACK_M`` of its YZ plane."""
+    ax, ay, az = r[0, 0], r[1, 0], r[2, 0]
+    off = ax * o[0] + ay * o[1] + az * o[2]
+    for i in range(xs.shape[0]):  # vectorised
+        keep[i] = abs(ax * xs[i] + ay * ys[i] + az * zs[i] - off) <= limit
+    k = 0
+    for i in range(xs.shape[0]):
+        if keep[i]:
+            cull[0, k], cull[1, k], cull[2, k] = xs[i], ys[i], zs[i]
+            idx[k] = i
+            k += 1
+    return k
+
+
 @_jit
 def _pad_reach(
     r: np.ndarray,
-    points: np.ndarray,
+    cull: np.ndarray,
+    k: int,
     half_width: float,
     z_lo: float,
     z_hi: float,
@@ -314,12 +380,13 @@ def _pad_reach(
     zs: np.ndarray,
     inside: np.ndarray,
 ) -> tuple[float, float]:
-    """The (N, 3) world ``points`` in the frame of the (4, 4) world pose ``r``, written into ``xs`` (|x|),
-    ``ys``, ``zs`` and ``inside`` (in the pads' reach: ``|x| <= half_width``, ``z_lo <= z <= z_hi``); returns
-    the reach's extreme (lo, hi) along y, (inf, -inf) where no point is in it."""
+    """The first ``k`` world points of ``cull`` (3, N) in the frame of the (4, 4) world pose ``r``, written
+    into ``xs`` (|x|), ``ys``, ``zs`` and ``inside`` (in the pads' reach: ``|x| <= half_width``,
+    ``z_lo <= z <= z_hi``); returns the reach's extreme (lo, hi) along y, (inf, -inf) where no point is in
+    it."""
     lo, hi = np.inf, -np.inf
-    for i in range(points.shape[0]):
-        px, py, pz = points[i, 0] - r[0, 3], points[i, 1] - r[1, 3], points[i, 2] - r[2, 3]
+    for i in range(k):
+        px, py, pz = cull[0, i] - r[0, 3], cull[1, i] - r[1, 3], cull[2, i] - r[2, 3]
         x = abs(r[0, 0] * px + r[1, 0] * py + r[2, 0] * pz)
         y = r[0, 1] * px + r[1, 1] * py + r[2, 1] * pz
         z = r[0, 2] * px + r[1, 2] * py + r[2, 2] * pz
@@ -345,40 +412,51 @@ def pad_contact_stats(
     """Per grasp frame: [depth of the shallower pad's contact from ``z_hi``, larger contact-normal angle to
     the closing axis (rad), smaller share of contact points in ``area``] (:func:`graspexp.planning.
     stability.pad_contacts`). points, normals : (N, 3) world; area : (N,) bool; poses : (B, 4, 4).
-    Returns (B, 3) float64; a side without contact points gives -inf, pi and 0."""
+    Returns (B, 3) float64; a side without contact points gives -inf, pi and 0. Consecutive poses with
+    one rotation share one cull of the points (:func:`_near_plane`); the sums run in point order."""
     n = points.shape[0]
     out = np.empty((poses.shape[0], 3))
+    px, py, pz = _soa(points)
+    keep, cull, idx = np.empty(n, dtype=np.bool_), np.empty((3, n)), np.empty(n, dtype=np.int64)
     xs, ys, zs = np.empty(n), np.empty(n), np.empty(n)
     inside = np.zeros(n, dtype=np.bool_)
-    for b in range(poses.shape[0]):
-        r = poses[b]
-        lo, hi = _pad_reach(r, points, half_width, z_lo, z_hi, xs, ys, zs, inside)
-        depth, angle, share = np.inf, 0.0, 1.0
-        for sign in (1.0, -1.0):
-            count, in_area, sum_z, ny = 0, 0, 0.0, 0.0
-            nx_, nz_ = 0.0, 0.0
-            for i in range(n):
-                if not inside[i]:
+    b = 0
+    while b < poses.shape[0]:
+        end, shift = _rotation_run(poses[:, :3, :3], poses[:, :3, 3], b)
+        k = _near_plane(
+            px, py, pz, poses[b, :3, :3], poses[b, :3, 3], half_width + shift + SLACK_M, keep, cull, idx
+        )
+        for g in range(b, end):
+            r = poses[g]
+            lo, hi = _pad_reach(r, cull, k, half_width, z_lo, z_hi, xs, ys, zs, inside)
+            depth, angle, share = np.inf, 0.0, 1.0
+            for sign in (1.0, -1.0):
+                count, in_area, sum_z, ny = 0, 0, 0.0, 0.0
+                nx_, nz_ = 0.0, 0.0
+                for j in range(k):
+                    if not inside[j]:
+                        continue
+                    if (sign > 0 and ys[j] >= hi - band) or (sign < 0 and ys[j] <= lo + band):
+                        i = idx[j]
+                        count += 1
+                        in_area += area[i]
+                        sum_z += zs[j]
+                        # the normal in the grasp frame: R^T n
+                        nx_ += r[0, 0] * normals[i, 0] + r[1, 0] * normals[i, 1] + r[2, 0] * normals[i, 2]
+                        ny += r[0, 1] * normals[i, 0] + r[1, 1] * normals[i, 1] + r[2, 1] * normals[i, 2]
+                        nz_ += r[0, 2] * normals[i, 0] + r[1, 2] * normals[i, 1] + r[2, 2] * normals[i, 2]
+                if count == 0:
+                    depth, angle, share = -np.inf, np.pi, 0.0
                     continue
-                if (sign > 0 and ys[i] >= hi - band) or (sign < 0 and ys[i] <= lo + band):
-                    count += 1
-                    in_area += area[i]
-                    sum_z += zs[i]
-                    # the normal in the grasp frame: R^T n
-                    nx_ += r[0, 0] * normals[i, 0] + r[1, 0] * normals[i, 1] + r[2, 0] * normals[i, 2]
-                    ny += r[0, 1] * normals[i, 0] + r[1, 1] * normals[i, 1] + r[2, 1] * normals[i, 2]
-                    nz_ += r[0, 2] * normals[i, 0] + r[1, 2] * normals[i, 1] + r[2, 2] * normals[i, 2]
-            if count == 0:
-                depth, angle, share = -np.inf, np.pi, 0.0
-                continue
-            depth = min(depth, z_hi - sum_z / count)
-            length = np.sqrt(nx_ * nx_ + ny * ny + nz_ * nz_)
-            a = np.pi if length == 0 else np.arccos(min(max(sign * ny / length, -1.0), 1.0))
-            angle = max(angle, a)
-            share = min(share, in_area / count)
-        out[b, 0] = depth
-        out[b, 1] = angle
-        out[b, 2] = share
+                depth = min(depth, z_hi - sum_z / count)
+                length = np.sqrt(nx_ * nx_ + ny * ny + nz_ * nz_)
+                a = np.pi if length == 0 else np.arccos(min(max(sign * ny / length, -1.0), 1.0))
+                angle = max(angle, a)
+                share = min(share, in_area / count)
+            out[g, 0] = depth
+            out[g, 1] = angle
+            out[g, 2] = share
+        b = end
     return out
 
 
@@ -398,11 +476,12 @@ def pad_edge_excess(
     point lies there or no point is in the pads' reach."""
     n = points.shape[0]
     out = np.full(poses.shape[0], -np.inf)
+    cull = np.ascontiguousarray(points.T)
     xs, ys, zs = np.empty(n), np.empty(n), np.empty(n)
     inside = np.zeros(n, dtype=np.bool_)
     for b in range(poses.shape[0]):
         r = poses[b]
-        lo, hi = _pad_reach(r, points, half_width, z_lo, z_hi, xs, ys, zs, inside)
+        lo, hi = _pad_reach(r, cull, n, half_width, z_lo, z_hi, xs, ys, zs, inside)
         if lo > hi:
             continue
         worst = -np.inf
@@ -423,6 +502,35 @@ COUNT_ALL = np.iinfo(np.int64).max
 """``stop_at`` of the swept-volume kernels that counts every point (no early stop)."""
 
 
+BOX_BLOCK = 128
+"""Points counted per vectorised block of :func:`_box_hits` before the ``stop_at`` test."""
+
+
+@_jit
+def _box_hits(
+    cull: np.ndarray, k: int, r: np.ndarray, h: float, finger: np.ndarray, palm: np.ndarray, stop_at: int
+) -> int:
+    """Points among the first ``k`` of ``cull`` (3, N) world inside the swept boxes of the (4, 4) pose
+    ``r`` with half opening ``h`` (:func:`swept_box_hits`), counted up to ``stop_at``: branch-free blocks
+    of :data:`BOX_BLOCK` points (vectorised), the test after each block."""
+    fx, ft, fz0, fz1, m = finger[0], finger[1], finger[2], finger[3], finger[4]
+    px, py, pz0, pz1 = palm[0], palm[1], palm[2], palm[3]
+    y0, y1 = h - m, h + ft + m
+    count = 0
+    for s in range(0, k, BOX_BLOCK):
+        for i in range(s, min(s + BOX_BLOCK, k)):
+            qx, qy, qz = cull[0, i] - r[0, 3], cull[1, i] - r[1, 3], cull[2, i] - r[2, 3]
+            z = r[0, 2] * qx + r[1, 2] * qy + r[2, 2] * qz
+            x = abs(r[0, 0] * qx + r[1, 0] * qy + r[2, 0] * qz)
+            y = abs(r[0, 1] * qx + r[1, 1] * qy + r[2, 1] * qz)
+            in_finger = (x <= fx) & (fz0 <= z) & (z <= fz1) & (y0 <= y) & (y <= y1)
+            in_palm = (x <= px) & (y <= py) & (pz0 <= z) & (z <= pz1)
+            count += in_finger | in_palm
+        if count >= stop_at:
+            return stop_at
+    return count
+
+
 @_jit
 def swept_box_hits(
     points: np.ndarray,
@@ -435,29 +543,23 @@ def swept_box_hits(
     """Points inside the swept finger and palm boxes of each grasp (:func:`graspexp.planning.collision.
     cloud_hits`). points : (N, 3) world; poses : (B, 4, 4); half_widths : (B,) half openings, m;
     finger : [half x, thickness, z lo, z hi, margin]; palm : [half x, half y, z lo, z hi], margin included
-    except in ``finger``'s y bounds; a grasp's count stops at ``stop_at`` (1: is it free?). Returns (B,)
-    int64."""
+    except in ``finger``'s y bounds; a grasp's count stops at ``stop_at`` (1: is it free?). Consecutive
+    poses with one rotation share one cull of the points (:func:`_near_plane`, by the wider box's half x).
+    Returns (B,) int64."""
+    n = points.shape[0]
     out = np.zeros(poses.shape[0], dtype=np.int64)
-    fx, ft, fz0, fz1, m = finger[0], finger[1], finger[2], finger[3], finger[4]
-    px, py, pz0, pz1 = palm[0], palm[1], palm[2], palm[3]
-    for b in range(poses.shape[0]):
-        r = poses[b]
-        h = half_widths[b]
-        count = 0
-        for i in range(points.shape[0]):
-            qx, qy, qz = points[i, 0] - r[0, 3], points[i, 1] - r[1, 3], points[i, 2] - r[2, 3]
-            z = r[0, 2] * qx + r[1, 2] * qy + r[2, 2] * qz
-            if z > fz1 and z > pz1:
-                continue
-            x = abs(r[0, 0] * qx + r[1, 0] * qy + r[2, 0] * qz)
-            y = abs(r[0, 1] * qx + r[1, 1] * qy + r[2, 1] * qz)
-            in_finger = x <= fx and fz0 <= z <= fz1 and h - m <= y <= h + ft + m
-            in_palm = x <= px and y <= py and pz0 <= z <= pz1
-            if in_finger or in_palm:
-                count += 1
-                if count >= stop_at:
-                    break
-        out[b] = count
+    xs, ys, zs = _soa(points)
+    keep, cull, idx = np.empty(n, dtype=np.bool_), np.empty((3, n)), np.empty(n, dtype=np.int64)
+    reach = max(finger[0], palm[0])
+    b = 0
+    while b < poses.shape[0]:
+        end, shift = _rotation_run(poses[:, :3, :3], poses[:, :3, 3], b)
+        k = _near_plane(
+            xs, ys, zs, poses[b, :3, :3], poses[b, :3, 3], reach + shift + SLACK_M, keep, cull, idx
+        )
+        for g in range(b, end):
+            out[g] = _box_hits(cull, k, poses[g], half_widths[g], finger, palm, stop_at)
+        b = end
     return out
 
 
