@@ -269,37 +269,80 @@ def slab_spans(
 
     points : (N, 3) float64 world; centers : (B, 3) frame origins; rotations : (B, 3, 3) frame axes as
     columns. Returns (B, 2) float64 relative to each origin, [0, 0] where no point qualifies
-    (:func:`graspexp.planning.pose.slab_spans_m`). Requires finite inputs (fastmath).
+    (:func:`graspexp.planning.pose.slab_spans_m`). Requires finite inputs (fastmath). Consecutive frames
+    with one rotation share one cull of the points (:func:`_near_plane`); a lone frame scans them all.
     """
-    xs = np.ascontiguousarray(points[:, 0])  # structure of arrays: the first pass vectorises
-    ys = np.ascontiguousarray(points[:, 1])
-    zs = np.ascontiguousarray(points[:, 2])
+    xs, ys, zs = _soa(points)  # structure of arrays: the first pass vectorises
     n = xs.shape[0]
     out = np.zeros((rotations.shape[0], 2))
-    big = 1e30  # a finite sentinel: fastmath assumes no inf
     y_lo = np.empty(n)  # y where inside, else +big
     y_hi = np.empty(n)  # y where inside, else -big
-    for b in range(rotations.shape[0]):
-        r = rotations[b]
-        cx, cy, cz = centers[b, 0], centers[b, 1], centers[b, 2]
-        for i in range(n):
-            px, py, pz = xs[i] - cx, ys[i] - cy, zs[i] - cz
-            x = r[0, 0] * px + r[1, 0] * py + r[2, 0] * pz
-            y = r[0, 1] * px + r[1, 1] * py + r[2, 1] * pz
-            z = r[0, 2] * px + r[1, 2] * py + r[2, 2] * pz
-            inside = (abs(x) <= half_width) & (z >= z_lo) & (z <= z_hi)  # no short circuit: selects
-            y_lo[i] = y if inside else big
-            y_hi[i] = y if inside else -big
-        # A second, scalar pass: LLVM does not vectorise float min/max reductions without function-wide
-        # no-NaN attributes, which numba does not set; fused into the first pass they halve its speed.
-        lo, hi = big, -big
-        for i in range(n):
-            lo = y_lo[i] if y_lo[i] < lo else lo
-            hi = y_hi[i] if y_hi[i] > hi else hi
-        if lo <= hi:  # some point was inside
-            out[b, 0] = lo
-            out[b, 1] = hi
+    keep, cull, idx = np.empty(n, dtype=np.bool_), np.empty((3, n)), np.empty(n, dtype=np.int64)
+    b = 0
+    while b < rotations.shape[0]:
+        end, shift = _rotation_run(rotations, centers, b)
+        if end - b == 1:
+            _slab_span(xs, ys, zs, n, rotations[b], centers[b], half_width, z_lo, z_hi, y_lo, y_hi, out[b])
+        else:
+            k = _near_plane(
+                xs, ys, zs, rotations[b], centers[b], half_width + shift + SLACK_M, keep, cull, idx
+            )
+            for g in range(b, end):
+                _slab_span(
+                    cull[0],
+                    cull[1],
+                    cull[2],
+                    k,
+                    rotations[g],
+                    centers[g],
+                    half_width,
+                    z_lo,
+                    z_hi,
+                    y_lo,
+                    y_hi,
+                    out[g],
+                )
+        b = end
     return out
+
+
+@_jit_fast
+def _slab_span(
+    xs: np.ndarray,
+    ys: np.ndarray,
+    zs: np.ndarray,
+    k: int,
+    r: np.ndarray,
+    c: np.ndarray,
+    half_width: float,
+    z_lo: float,
+    z_hi: float,
+    y_lo: np.ndarray,
+    y_hi: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """:func:`slab_spans` of the first ``k`` points (coordinate arrays, world) in the frame of rotation
+    ``r`` (3, 3) at origin ``c`` (3,), written into ``out`` (2,) where some point is inside; ``y_lo``,
+    ``y_hi`` (N,) are scratch."""
+    big = 1e30  # a finite sentinel: fastmath assumes no inf
+    cx, cy, cz = c[0], c[1], c[2]
+    for i in range(k):
+        px, py, pz = xs[i] - cx, ys[i] - cy, zs[i] - cz
+        x = r[0, 0] * px + r[1, 0] * py + r[2, 0] * pz
+        y = r[0, 1] * px + r[1, 1] * py + r[2, 1] * pz
+        z = r[0, 2] * px + r[1, 2] * py + r[2, 2] * pz
+        inside = (abs(x) <= half_width) & (z >= z_lo) & (z <= z_hi)  # no short circuit: selects
+        y_lo[i] = y if inside else big
+        y_hi[i] = y if inside else -big
+    # A second, scalar pass: LLVM does not vectorise float min/max reductions without function-wide
+    # no-NaN attributes, which numba does not set; fused into the first pass they halve its speed.
+    lo, hi = big, -big
+    for i in range(k):
+        lo = y_lo[i] if y_lo[i] < lo else lo
+        hi = y_hi[i] if y_hi[i] > hi else hi
+    if lo <= hi:  # some point was inside
+        out[0] = lo
+        out[1] = hi
 
 
 SLACK_M = 1e-9
@@ -359,11 +402,10 @@ def _near_plane(
     for i in range(xs.shape[0]):  # vectorised
         keep[i] = abs(ax * xs[i] + ay * ys[i] + az * zs[i] - off) <= limit
     k = 0
-    for i in range(xs.shape[0]):
-        if keep[i]:
-            cull[0, k], cull[1, k], cull[2, k] = xs[i], ys[i], zs[i]
-            idx[k] = i
-            k += 1
+    for i in range(xs.shape[0]):  # branch-free: the kept points are spatially mixed
+        cull[0, k], cull[1, k], cull[2, k] = xs[i], ys[i], zs[i]
+        idx[k] = i
+        k += keep[i]
     return k
 
 
@@ -384,17 +426,17 @@ def _pad_reach(
     into ``xs`` (|x|), ``ys``, ``zs`` and ``inside`` (in the pads' reach: ``|x| <= half_width``,
     ``z_lo <= z <= z_hi``); returns the reach's extreme (lo, hi) along y, (inf, -inf) where no point is in
     it."""
-    lo, hi = np.inf, -np.inf
-    for i in range(k):
+    for i in range(k):  # vectorised
         px, py, pz = cull[0, i] - r[0, 3], cull[1, i] - r[1, 3], cull[2, i] - r[2, 3]
         x = abs(r[0, 0] * px + r[1, 0] * py + r[2, 0] * pz)
         y = r[0, 1] * px + r[1, 1] * py + r[2, 1] * pz
         z = r[0, 2] * px + r[1, 2] * py + r[2, 2] * pz
-        ok = x <= half_width and z >= z_lo and z <= z_hi
-        xs[i], ys[i], zs[i], inside[i] = x, y, z, ok
-        if ok:
-            lo = min(lo, y)
-            hi = max(hi, y)
+        xs[i], ys[i], zs[i], inside[i] = x, y, z, (x <= half_width) & (z >= z_lo) & (z <= z_hi)
+    lo, hi = np.inf, -np.inf
+    for i in range(k):
+        if inside[i]:
+            lo = min(lo, ys[i])
+            hi = max(hi, ys[i])
     return lo, hi
 
 
@@ -429,22 +471,29 @@ def pad_contact_stats(
         for g in range(b, end):
             r = poses[g]
             lo, hi = _pad_reach(r, cull, k, half_width, z_lo, z_hi, xs, ys, zs, inside)
+            sums = np.zeros((2, 6))  # per side (left: +Y, right: -Y): count, in area, z, normal x, y, z
+            for j in range(k):  # both sides in one pass, each summed in point order
+                if not inside[j]:
+                    continue
+                left, right = ys[j] >= hi - band, ys[j] <= lo + band
+                if not (left or right):
+                    continue
+                i = idx[j]
+                # the normal in the grasp frame: R^T n
+                nx = r[0, 0] * normals[i, 0] + r[1, 0] * normals[i, 1] + r[2, 0] * normals[i, 2]
+                ny = r[0, 1] * normals[i, 0] + r[1, 1] * normals[i, 1] + r[2, 1] * normals[i, 2]
+                nz = r[0, 2] * normals[i, 0] + r[1, 2] * normals[i, 1] + r[2, 2] * normals[i, 2]
+                for side, hit in ((0, left), (1, right)):
+                    if hit:
+                        sums[side, 0] += 1
+                        sums[side, 1] += area[i]
+                        sums[side, 2] += zs[j]
+                        sums[side, 3] += nx
+                        sums[side, 4] += ny
+                        sums[side, 5] += nz
             depth, angle, share = np.inf, 0.0, 1.0
-            for sign in (1.0, -1.0):
-                count, in_area, sum_z, ny = 0, 0, 0.0, 0.0
-                nx_, nz_ = 0.0, 0.0
-                for j in range(k):
-                    if not inside[j]:
-                        continue
-                    if (sign > 0 and ys[j] >= hi - band) or (sign < 0 and ys[j] <= lo + band):
-                        i = idx[j]
-                        count += 1
-                        in_area += area[i]
-                        sum_z += zs[j]
-                        # the normal in the grasp frame: R^T n
-                        nx_ += r[0, 0] * normals[i, 0] + r[1, 0] * normals[i, 1] + r[2, 0] * normals[i, 2]
-                        ny += r[0, 1] * normals[i, 0] + r[1, 1] * normals[i, 1] + r[2, 1] * normals[i, 2]
-                        nz_ += r[0, 2] * normals[i, 0] + r[1, 2] * normals[i, 1] + r[2, 2] * normals[i, 2]
+            for side, sign in ((0, 1.0), (1, -1.0)):
+                count, in_area, sum_z, nx_, ny, nz_ = sums[side]
                 if count == 0:
                     depth, angle, share = -np.inf, np.pi, 0.0
                     continue
