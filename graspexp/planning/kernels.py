@@ -403,9 +403,11 @@ def _near_plane(
         keep[i] = abs(ax * xs[i] + ay * ys[i] + az * zs[i] - off) <= limit
     k = 0
     for i in range(xs.shape[0]):  # branch-free: the kept points are spatially mixed
-        cull[0, k], cull[1, k], cull[2, k] = xs[i], ys[i], zs[i]
         idx[k] = i
         k += keep[i]
+    for j in range(k):
+        i = idx[j]
+        cull[0, j], cull[1, j], cull[2, j] = xs[i], ys[i], zs[i]
     return k
 
 
@@ -420,23 +422,26 @@ def _pad_reach(
     xs: np.ndarray,
     ys: np.ndarray,
     zs: np.ndarray,
-    inside: np.ndarray,
+    y_lo: np.ndarray,
+    y_hi: np.ndarray,
 ) -> tuple[float, float]:
     """The first ``k`` world points of ``cull`` (3, N) in the frame of the (4, 4) world pose ``r``, written
-    into ``xs`` (|x|), ``ys``, ``zs`` and ``inside`` (in the pads' reach: ``|x| <= half_width``,
-    ``z_lo <= z <= z_hi``); returns the reach's extreme (lo, hi) along y, (inf, -inf) where no point is in
-    it."""
+    into ``xs`` (|x|), ``ys`` and ``zs``, and into ``y_lo`` / ``y_hi`` y where the point is in the pads'
+    reach (``|x| <= half_width``, ``z_lo <= z <= z_hi``), else +inf / -inf; returns the reach's extreme
+    (lo, hi) along y, (inf, -inf) where no point is in it."""
     for i in range(k):  # vectorised
         px, py, pz = cull[0, i] - r[0, 3], cull[1, i] - r[1, 3], cull[2, i] - r[2, 3]
         x = abs(r[0, 0] * px + r[1, 0] * py + r[2, 0] * pz)
         y = r[0, 1] * px + r[1, 1] * py + r[2, 1] * pz
         z = r[0, 2] * px + r[1, 2] * py + r[2, 2] * pz
-        xs[i], ys[i], zs[i], inside[i] = x, y, z, (x <= half_width) & (z >= z_lo) & (z <= z_hi)
+        inside = (x <= half_width) & (z >= z_lo) & (z <= z_hi)
+        xs[i], ys[i], zs[i] = x, y, z
+        y_lo[i] = y if inside else np.inf
+        y_hi[i] = y if inside else -np.inf
     lo, hi = np.inf, -np.inf
-    for i in range(k):
-        if inside[i]:
-            lo = min(lo, ys[i])
-            hi = max(hi, ys[i])
+    for i in range(k):  # selects, no branches
+        lo = y_lo[i] if y_lo[i] < lo else lo
+        hi = y_hi[i] if y_hi[i] > hi else hi
     return lo, hi
 
 
@@ -460,8 +465,7 @@ def pad_contact_stats(
     out = np.empty((poses.shape[0], 3))
     px, py, pz = _soa(points)
     keep, cull, idx = np.empty(n, dtype=np.bool_), np.empty((3, n)), np.empty(n, dtype=np.int64)
-    xs, ys, zs = np.empty(n), np.empty(n), np.empty(n)
-    inside = np.zeros(n, dtype=np.bool_)
+    xs, ys, zs, y_lo, y_hi = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     b = 0
     while b < poses.shape[0]:
         end, shift = _rotation_run(poses[:, :3, :3], poses[:, :3, 3], b)
@@ -470,12 +474,13 @@ def pad_contact_stats(
         )
         for g in range(b, end):
             r = poses[g]
-            lo, hi = _pad_reach(r, cull, k, half_width, z_lo, z_hi, xs, ys, zs, inside)
-            sums = np.zeros((2, 6))  # per side (left: +Y, right: -Y): count, in area, z, normal x, y, z
-            for j in range(k):  # both sides in one pass, each summed in point order
-                if not inside[j]:
-                    continue
-                left, right = ys[j] >= hi - band, ys[j] <= lo + band
+            lo, hi = _pad_reach(r, cull, k, half_width, z_lo, z_hi, xs, ys, zs, y_lo, y_hi)
+            if lo > hi:
+                out[g, 0], out[g, 1], out[g, 2] = -np.inf, np.pi, 0.0
+                continue
+            sums = np.zeros((2, 6))  # per pad (left: +Y, right: -Y): count, in area, z, normal x, y, z
+            for j in range(k):  # both pads in one pass, each summed in point order
+                left, right = y_hi[j] >= hi - band, y_lo[j] <= lo + band
                 if not (left or right):
                     continue
                 i = idx[j]
@@ -502,9 +507,7 @@ def pad_contact_stats(
                 a = np.pi if length == 0 else np.arccos(min(max(sign * ny / length, -1.0), 1.0))
                 angle = max(angle, a)
                 share = min(share, in_area / count)
-            out[g, 0] = depth
-            out[g, 1] = angle
-            out[g, 2] = share
+            out[g, 0], out[g, 1], out[g, 2] = depth, angle, share
         b = end
     return out
 
@@ -526,11 +529,9 @@ def pad_edge_excess(
     n = points.shape[0]
     out = np.full(poses.shape[0], -np.inf)
     cull = np.ascontiguousarray(points.T)
-    xs, ys, zs = np.empty(n), np.empty(n), np.empty(n)
-    inside = np.zeros(n, dtype=np.bool_)
+    xs, ys, zs, y_lo, y_hi = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     for b in range(poses.shape[0]):
-        r = poses[b]
-        lo, hi = _pad_reach(r, cull, n, half_width, z_lo, z_hi, xs, ys, zs, inside)
+        lo, hi = _pad_reach(poses[b], cull, n, half_width, z_lo, z_hi, xs, ys, zs, y_lo, y_hi)
         if lo > hi:
             continue
         worst = -np.inf
