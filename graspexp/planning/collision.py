@@ -166,6 +166,18 @@ class Placement:
     below_support: np.ndarray
     collides: np.ndarray
 
+    def rows(self, index: slice | np.ndarray) -> "Placement":
+        """The placements of the candidates ``index`` selects."""
+        return Placement(
+            poses=self.poses[index],
+            widths_m=self.widths_m[index],
+            lift_m=self.lift_m[index],
+            ok=self.ok[index],
+            too_wide=self.too_wide[index],
+            below_support=self.below_support[index],
+            collides=self.collides[index],
+        )
+
     def counts(self) -> dict[str, int]:
         """Rejections per check, for messages and ``Grasp.extras``."""
         return {
