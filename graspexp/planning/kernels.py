@@ -270,7 +270,7 @@ def slab_spans(
     points : (N, 3) float64 world; centers : (B, 3) frame origins; rotations : (B, 3, 3) frame axes as
     columns. Returns (B, 2) float64 relative to each origin, [0, 0] where no point qualifies
     (:func:`graspexp.planning.pose.slab_spans_m`). Requires finite inputs (fastmath). Consecutive frames
-    with one rotation share one cull of the points (:func:`_near_plane`); a lone frame scans them all.
+    with one rotation share one cull of the points (:func:`_run_cull`); a lone frame scans them all.
     """
     xs, ys, zs = _soa(points)  # structure of arrays: the first pass vectorises
     n = xs.shape[0]
@@ -278,30 +278,29 @@ def slab_spans(
     y_lo = np.empty(n)  # y where inside, else +big
     y_hi = np.empty(n)  # y where inside, else -big
     keep, cull, idx = np.empty(n, dtype=np.bool_), np.empty((3, n)), np.empty(n, dtype=np.int64)
+    box = np.array([[half_width, z_lo, z_hi]])
     b = 0
     while b < rotations.shape[0]:
-        end, shift = _rotation_run(rotations, centers, b)
-        if end - b == 1:
+        if b + 1 == rotations.shape[0] or np.any(rotations[b + 1] != rotations[b]):  # a lone frame
             _slab_span(xs, ys, zs, n, rotations[b], centers[b], half_width, z_lo, z_hi, y_lo, y_hi, out[b])
-        else:
-            k = _near_plane(
-                xs, ys, zs, rotations[b], centers[b], half_width + shift + SLACK_M, keep, cull, idx
+            b += 1
+            continue
+        end, k = _run_cull(xs, ys, zs, rotations, centers, b, box, keep, cull, idx)
+        for g in range(b, end):
+            _slab_span(
+                cull[0],
+                cull[1],
+                cull[2],
+                k,
+                rotations[g],
+                centers[g],
+                half_width,
+                z_lo,
+                z_hi,
+                y_lo,
+                y_hi,
+                out[g],
             )
-            for g in range(b, end):
-                _slab_span(
-                    cull[0],
-                    cull[1],
-                    cull[2],
-                    k,
-                    rotations[g],
-                    centers[g],
-                    half_width,
-                    z_lo,
-                    z_hi,
-                    y_lo,
-                    y_hi,
-                    out[g],
-                )
         b = end
     return out
 
@@ -347,7 +346,7 @@ def _slab_span(
 
 SLACK_M = 1e-9
 """Added to a cull's bound, m: far above the rounding of coordinates below a kilometre, so a point culled
-by :func:`_near_plane` fails the exact test too."""
+by :func:`_run_cull` fails the exact test too."""
 
 
 @_jit
@@ -361,12 +360,13 @@ def _soa(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 @_jit
-def _rotation_run(rotations: np.ndarray, origins: np.ndarray, b: int) -> tuple[int, float]:
+def _rotation_run(rotations: np.ndarray, origins: np.ndarray, b: int) -> tuple[int, float, float, float]:
     """End (exclusive) of the run of frames from ``b`` whose (3, 3) rotation is bitwise ``rotations[b]``,
-    and the largest distance of their origins (B, 3) from ``origins[b]`` along that rotation's X axis, m:
-    the frames of one path and roll, moved along their Y and Z axes only, share one cull."""
+    and how far their origins (B, 3) lie from ``origins[b]`` along that rotation's axes, m: the largest
+    distance along X and the smallest and largest offset along Z (the frames of one path and roll move
+    along their Y and Z axes only)."""
     r, o = rotations[b], origins[b]
-    end, shift = b + 1, 0.0
+    end, dx, dz_lo, dz_hi = b + 1, 0.0, 0.0, 0.0
     while end < rotations.shape[0]:
         q = rotations[end]
         same = True
@@ -375,32 +375,49 @@ def _rotation_run(rotations: np.ndarray, origins: np.ndarray, b: int) -> tuple[i
                 same = same and q[i, j] == r[i, j]
         if not same:
             break
-        d = origins[end]
-        shift = max(shift, abs(r[0, 0] * (d[0] - o[0]) + r[1, 0] * (d[1] - o[1]) + r[2, 0] * (d[2] - o[2])))
+        d0, d1, d2 = origins[end, 0] - o[0], origins[end, 1] - o[1], origins[end, 2] - o[2]
+        dx = max(dx, abs(r[0, 0] * d0 + r[1, 0] * d1 + r[2, 0] * d2))
+        dz = r[0, 2] * d0 + r[1, 2] * d1 + r[2, 2] * d2
+        dz_lo, dz_hi = min(dz_lo, dz), max(dz_hi, dz)
         end += 1
-    return end, shift
+    return end, dx, dz_lo, dz_hi
 
 
 @_jit
-def _near_plane(
+def _run_cull(
     xs: np.ndarray,
     ys: np.ndarray,
     zs: np.ndarray,
-    r: np.ndarray,
-    o: np.ndarray,
-    limit: float,
+    rotations: np.ndarray,
+    origins: np.ndarray,
+    b: int,
+    boxes: np.ndarray,
     keep: np.ndarray,
     cull: np.ndarray,
     idx: np.ndarray,
-) -> int:
-    """Copy the points (coordinate arrays, world) with ``|x| <= limit`` in the frame of the (3, 3)
-    rotation ``r`` at the origin ``o`` into the rows of ``cull`` (3, N) and their indices, ascending, into
-    ``idx``; return their count. ``keep`` (N,) bool is scratch. A frame with the same rotation whose origin
-    lies ``s`` from ``o`` along X sees no other point within ``limit - s - SLACK_M`` of its YZ plane."""
-    ax, ay, az = r[0, 0], r[1, 0], r[2, 0]
-    off = ax * o[0] + ay * o[1] + az * o[2]
-    for i in range(xs.shape[0]):  # vectorised
-        keep[i] = abs(ax * xs[i] + ay * ys[i] + az * zs[i] - off) <= limit
+) -> tuple[int, int]:
+    """The end of the run of frames from ``b`` (:func:`_rotation_run`) and the count ``k`` of the points
+    (coordinate arrays, world) that may lie, in some frame of the run, in one of the slabs ``boxes``
+    (S, 3), rows [half x, z lo, z hi] (``|x| <= half x``, ``z lo <= z <= z hi``, any y, frame axes, m);
+    their coordinates are copied into the first ``k`` columns of ``cull`` (3, N) and their indices,
+    ascending, into ``idx``. ``keep`` (N,) bool is scratch. The bounds are those of frame ``b`` grown by
+    the run's offsets and :data:`SLACK_M`: every point left out fails the exact test in every frame."""
+    end, dx, dz_lo, dz_hi = _rotation_run(rotations, origins, b)
+    r, o = rotations[b], origins[b]
+    ax, ay, az, cx, cy, cz = r[0, 0], r[1, 0], r[2, 0], r[0, 2], r[1, 2], r[2, 2]
+    off_x, off_z = ax * o[0] + ay * o[1] + az * o[2], cx * o[0] + cy * o[1] + cz * o[2]
+    bounds = np.empty_like(boxes)
+    for s in range(boxes.shape[0]):
+        bounds[s, 0] = boxes[s, 0] + dx + SLACK_M
+        bounds[s, 1] = boxes[s, 1] + dz_lo - SLACK_M
+        bounds[s, 2] = boxes[s, 2] + dz_hi + SLACK_M
+    keep[: xs.shape[0]] = False
+    for s in range(bounds.shape[0]):
+        x_max, z_min, z_max = bounds[s, 0], bounds[s, 1], bounds[s, 2]
+        for i in range(xs.shape[0]):  # vectorised
+            x = abs(ax * xs[i] + ay * ys[i] + az * zs[i] - off_x)
+            z = cx * xs[i] + cy * ys[i] + cz * zs[i] - off_z
+            keep[i] |= (x <= x_max) & (z >= z_min) & (z <= z_max)
     k = 0
     for i in range(xs.shape[0]):  # branch-free: the kept points are spatially mixed
         idx[k] = i
@@ -408,7 +425,7 @@ def _near_plane(
     for j in range(k):
         i = idx[j]
         cull[0, j], cull[1, j], cull[2, j] = xs[i], ys[i], zs[i]
-    return k
+    return end, k
 
 
 @_jit
@@ -460,18 +477,16 @@ def pad_contact_stats(
     the closing axis (rad), smaller share of contact points in ``area``] (:func:`graspexp.planning.
     stability.pad_contacts`). points, normals : (N, 3) world; area : (N,) bool; poses : (B, 4, 4).
     Returns (B, 3) float64; a side without contact points gives -inf, pi and 0. Consecutive poses with
-    one rotation share one cull of the points (:func:`_near_plane`); the sums run in point order."""
+    one rotation share one cull of the points (:func:`_run_cull`); the sums run in point order."""
     n = points.shape[0]
     out = np.empty((poses.shape[0], 3))
     px, py, pz = _soa(points)
     keep, cull, idx = np.empty(n, dtype=np.bool_), np.empty((3, n)), np.empty(n, dtype=np.int64)
     xs, ys, zs, y_lo, y_hi = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    box = np.array([[half_width, z_lo, z_hi]])
     b = 0
     while b < poses.shape[0]:
-        end, shift = _rotation_run(poses[:, :3, :3], poses[:, :3, 3], b)
-        k = _near_plane(
-            px, py, pz, poses[b, :3, :3], poses[b, :3, 3], half_width + shift + SLACK_M, keep, cull, idx
-        )
+        end, k = _run_cull(px, py, pz, poses[:, :3, :3], poses[:, :3, 3], b, box, keep, cull, idx)
         for g in range(b, end):
             r = poses[g]
             lo, hi = _pad_reach(r, cull, k, half_width, z_lo, z_hi, xs, ys, zs, y_lo, y_hi)
@@ -594,19 +609,16 @@ def swept_box_hits(
     cloud_hits`). points : (N, 3) world; poses : (B, 4, 4); half_widths : (B,) half openings, m;
     finger : [half x, thickness, z lo, z hi, margin]; palm : [half x, half y, z lo, z hi], margin included
     except in ``finger``'s y bounds; a grasp's count stops at ``stop_at`` (1: is it free?). Consecutive
-    poses with one rotation share one cull of the points (:func:`_near_plane`, by the wider box's half x).
+    poses with one rotation share one cull of the points (:func:`_run_cull`, by the finger and palm slabs).
     Returns (B,) int64."""
     n = points.shape[0]
     out = np.zeros(poses.shape[0], dtype=np.int64)
     xs, ys, zs = _soa(points)
     keep, cull, idx = np.empty(n, dtype=np.bool_), np.empty((3, n)), np.empty(n, dtype=np.int64)
-    reach = max(finger[0], palm[0])
+    boxes = np.array([[finger[0], finger[2], finger[3]], [palm[0], palm[2], palm[3]]])
     b = 0
     while b < poses.shape[0]:
-        end, shift = _rotation_run(poses[:, :3, :3], poses[:, :3, 3], b)
-        k = _near_plane(
-            xs, ys, zs, poses[b, :3, :3], poses[b, :3, 3], reach + shift + SLACK_M, keep, cull, idx
-        )
+        end, k = _run_cull(xs, ys, zs, poses[:, :3, :3], poses[:, :3, 3], b, boxes, keep, cull, idx)
         for g in range(b, end):
             out[g] = _box_hits(cull, k, poses[g], half_widths[g], finger, palm, stop_at)
         b = end
