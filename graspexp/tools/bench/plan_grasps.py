@@ -7,7 +7,8 @@ Usage::
     python -m graspexp bench.plan_grasps --check FILE.npz [key=value ...]
 
 For every planner (``planner=a,b``; default ``optimal,optimal_plus``), dataset (``dataset=a,b``; default the
-paper's), mode (``mode=a,b``; default the paper's) and object, ``--poses`` requests are planned: pose 0
+paper's), mode (``mode=a,b``; default the paper's) and object (``objects=[...]``, default every staged
+one), ``--poses`` requests are planned: pose 0
 upright (:func:`graspexp.run.upright.upright_request`, the plan bench's request), then turned about Z (odd
 poses) or uniformly (even poses) by a rotation seeded by the object and pose, resting on the support
 (:func:`graspexp.run.upright.resting_pose`), each with the planner seed of that trial index. Saved per plan:
@@ -49,7 +50,7 @@ def plan_all(
                 cfg = compose_checked(
                     [f"planner={planner}", f"dataset={dataset}", f"mode={mode}", *overrides], PROG
                 )
-                for name in available_objects(cfg.dataset):
+                for name in list(cfg.objects) if cfg.objects else available_objects(cfg.dataset):
                     model = job_object(cfg, name)
                     for i in range(poses):
                         rows.append((f"{planner}/{dataset}/{mode}/{name}/{i}", _plan(cfg, model, i)))
