@@ -626,6 +626,30 @@ def swept_box_hits(
 
 
 @_jit
+def box_lowest_z(
+    poses: np.ndarray, half_widths: np.ndarray, finger: np.ndarray, palm: np.ndarray
+) -> np.ndarray:
+    """Lowest world z of the swept finger and palm boxes of each grasp (:func:`graspexp.planning.collision.
+    lowest_z`): per box ``t_z + sum_a min(R[2, a] lo_a, R[2, a] hi_a)`` summed over a = x, y, z in order,
+    the smallest of the three boxes. poses : (B, 4, 4); half_widths : (B,) half openings, m;
+    finger : [width, thickness, z lo, z hi]; palm : [x, y, z lo, z hi] (sizes, not halves), z lo swept.
+    Returns (B,) float64, m."""
+    out = np.empty(poses.shape[0])
+    fx, ft = finger[0] / 2, finger[1]
+    px, py = palm[0] / 2, palm[1] / 2
+    for b in range(poses.shape[0]):
+        r0, r1, r2 = poses[b, 2, 0], poses[b, 2, 1], poses[b, 2, 2]
+        h = half_widths[b]
+        sx = min(r0 * -fx, r0 * fx)
+        sz = min(r2 * finger[2], r2 * finger[3])
+        left = sx + min(r1 * h, r1 * (h + ft)) + sz
+        right = sx + min(r1 * (-h - ft), r1 * -h) + sz
+        base = min(r0 * -px, r0 * px) + min(r1 * -py, r1 * py) + min(r2 * palm[2], r2 * palm[3])
+        out[b] = poses[b, 2, 3] + min(min(left, right), base)
+    return out
+
+
+@_jit
 def swept_hull_hits(
     points: np.ndarray,
     poses: np.ndarray,
