@@ -273,6 +273,7 @@ def slab_spans(
     with one rotation share one cull of the points (:func:`_run_cull`); a lone frame scans them all.
     """
     xs, ys, zs = _soa(points)  # structure of arrays: the first pass vectorises
+    pts32 = _soa32(points)
     n = xs.shape[0]
     out = np.zeros((rotations.shape[0], 2))
     y_lo = np.empty(n)  # y where inside, else +big
@@ -285,7 +286,7 @@ def slab_spans(
             _slab_span(xs, ys, zs, n, rotations[b], centers[b], half_width, z_lo, z_hi, y_lo, y_hi, out[b])
             b += 1
             continue
-        end, k = _run_cull(xs, ys, zs, rotations, centers, b, box, keep, cull, idx)
+        end, k = _run_cull(pts32, xs, ys, zs, rotations, centers, b, box, keep, cull, idx)
         for g in range(b, end):
             _slab_span(
                 cull[0],
@@ -384,7 +385,22 @@ def _rotation_run(rotations: np.ndarray, origins: np.ndarray, b: int) -> tuple[i
 
 
 @_jit
+def _soa32(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """The (N, 3) points as three float32 coordinate arrays (the cull's pass moves half the bytes and
+    runs twice as wide) and the slack, m, that covers the float32 rounding of a frame coordinate computed
+    from them (:func:`_run_cull`): ``SLACK_M`` plus 1e-6 x the largest coordinate magnitude, generous
+    for float32's 6e-8 relative step."""
+    x32, y32, z32 = (
+        points[:, 0].astype(np.float32),
+        points[:, 1].astype(np.float32),
+        points[:, 2].astype(np.float32),
+    )
+    return x32, y32, z32, SLACK_M + 1e-6 * (np.abs(points).max() if points.shape[0] else 0.0)
+
+
+@_jit
 def _run_cull(
+    pts32: tuple[np.ndarray, np.ndarray, np.ndarray, float],
     xs: np.ndarray,
     ys: np.ndarray,
     zs: np.ndarray,
@@ -400,23 +416,26 @@ def _run_cull(
     (coordinate arrays, world) that may lie, in some frame of the run, in one of the slabs ``boxes``
     (S, 3), rows [half x, z lo, z hi] (``|x| <= half x``, ``z lo <= z <= z hi``, any y, frame axes, m);
     their coordinates are copied into the first ``k`` columns of ``cull`` (3, N) and their indices,
-    ascending, into ``idx``. ``keep`` (N,) bool is scratch. The bounds are those of frame ``b`` grown by
-    the run's offsets and :data:`SLACK_M`: every point left out fails the exact test in every frame."""
+    ascending, into ``idx``. ``keep`` (N,) bool is scratch. The test runs in float32 on ``pts32``
+    (:func:`_soa32`), its bounds those of frame ``b`` grown by the run's offsets, the float32 slack (the
+    origin's magnitude included) and :data:`SLACK_M`: every point left out fails the exact test in every
+    frame."""
+    x32, y32, z32, slack = pts32
     end, dx, dz_lo, dz_hi = _rotation_run(rotations, origins, b)
     r, o = rotations[b], origins[b]
-    ax, ay, az, cx, cy, cz = r[0, 0], r[1, 0], r[2, 0], r[0, 2], r[1, 2], r[2, 2]
-    off_x, off_z = ax * o[0] + ay * o[1] + az * o[2], cx * o[0] + cy * o[1] + cz * o[2]
-    bounds = np.empty_like(boxes)
-    for s in range(boxes.shape[0]):
-        bounds[s, 0] = boxes[s, 0] + dx + SLACK_M
-        bounds[s, 1] = boxes[s, 1] + dz_lo - SLACK_M
-        bounds[s, 2] = boxes[s, 2] + dz_hi + SLACK_M
+    slack += 1e-6 * max(abs(o[0]), abs(o[1]), abs(o[2]))
+    ax, ay, az = np.float32(r[0, 0]), np.float32(r[1, 0]), np.float32(r[2, 0])
+    cx, cy, cz = np.float32(r[0, 2]), np.float32(r[1, 2]), np.float32(r[2, 2])
+    off_x = np.float32(r[0, 0] * o[0] + r[1, 0] * o[1] + r[2, 0] * o[2])
+    off_z = np.float32(r[0, 2] * o[0] + r[1, 2] * o[1] + r[2, 2] * o[2])
     keep[: xs.shape[0]] = False
-    for s in range(bounds.shape[0]):
-        x_max, z_min, z_max = bounds[s, 0], bounds[s, 1], bounds[s, 2]
+    for s in range(boxes.shape[0]):
+        x_max = np.float32(boxes[s, 0] + dx + slack)
+        z_min = np.float32(boxes[s, 1] + dz_lo - slack)
+        z_max = np.float32(boxes[s, 2] + dz_hi + slack)
         for i in range(xs.shape[0]):  # vectorised
-            x = abs(ax * xs[i] + ay * ys[i] + az * zs[i] - off_x)
-            z = cx * xs[i] + cy * ys[i] + cz * zs[i] - off_z
+            x = abs(ax * x32[i] + ay * y32[i] + az * z32[i] - off_x)
+            z = cx * x32[i] + cy * y32[i] + cz * z32[i] - off_z
             keep[i] |= (x <= x_max) & (z >= z_min) & (z <= z_max)
     k = 0
     for i in range(xs.shape[0]):  # branch-free: the kept points are spatially mixed
@@ -481,12 +500,13 @@ def pad_contact_stats(
     n = points.shape[0]
     out = np.empty((poses.shape[0], 3))
     px, py, pz = _soa(points)
+    pts32 = _soa32(points)
     keep, cull, idx = np.empty(n, dtype=np.bool_), np.empty((3, n)), np.empty(n, dtype=np.int64)
     xs, ys, zs, y_lo, y_hi = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     box = np.array([[half_width, z_lo, z_hi]])
     b = 0
     while b < poses.shape[0]:
-        end, k = _run_cull(px, py, pz, poses[:, :3, :3], poses[:, :3, 3], b, box, keep, cull, idx)
+        end, k = _run_cull(pts32, px, py, pz, poses[:, :3, :3], poses[:, :3, 3], b, box, keep, cull, idx)
         for g in range(b, end):
             r = poses[g]
             lo, hi = _pad_reach(r, cull, k, half_width, z_lo, z_hi, xs, ys, zs, y_lo, y_hi)
@@ -614,11 +634,12 @@ def swept_box_hits(
     n = points.shape[0]
     out = np.zeros(poses.shape[0], dtype=np.int64)
     xs, ys, zs = _soa(points)
+    pts32 = _soa32(points)
     keep, cull, idx = np.empty(n, dtype=np.bool_), np.empty((3, n)), np.empty(n, dtype=np.int64)
     boxes = np.array([[finger[0], finger[2], finger[3]], [palm[0], palm[2], palm[3]]])
     b = 0
     while b < poses.shape[0]:
-        end, k = _run_cull(xs, ys, zs, poses[:, :3, :3], poses[:, :3, 3], b, boxes, keep, cull, idx)
+        end, k = _run_cull(pts32, xs, ys, zs, poses[:, :3, :3], poses[:, :3, 3], b, boxes, keep, cull, idx)
         for g in range(b, end):
             out[g] = _box_hits(cull, k, poses[g], half_widths[g], finger, palm, stop_at)
         b = end
