@@ -11,7 +11,16 @@ kernels still work, compiled afresh in every process.
 The public wrappers live with their meaning: :func:`graspexp.planning.cost.all_path_costs` and
 :func:`~graspexp.planning.cost.distance_term`, :func:`graspexp.planning.clusters.segment` and
 :func:`~graspexp.planning.clusters.max_radii_m`, :func:`graspexp.planning.pose.grasp_rotations` and
-:func:`~graspexp.planning.pose.slab_spans_m`.
+:func:`~graspexp.planning.pose.slab_spans_m`, :func:`graspexp.planning.collision.cloud_hits` and
+:func:`~graspexp.planning.collision.lowest_z`, :func:`graspexp.planning.stability.pad_contacts` and
+:func:`~graspexp.planning.stability.pad_edge_excess_m`.
+
+The kernels over a batch of grasp frames (the section, the swept boxes, the pads' contacts) see the
+frames ``optimal_plus`` tries for one path and roll as a run of consecutive frames with one rotation,
+moved along their Y and Z axes only: per run one pass over the cloud keeps the points near the frames'
+YZ plane (:func:`_run_cull`), and every frame of the run scans those. The cull only leaves out points the
+exact test would reject, and the exact tests and sums are the same expressions in the same point order,
+so the results are bit for bit those of a scan over every point.
 """
 
 import os

@@ -3,7 +3,8 @@ and the planner bench show (no simulation; the object is not dropped).
 
 The pose is the identity rotation translated so that the mesh's lowest point sits on
 ``z = mode.support_height_m`` (x = y = 0). The plan's seed is the runner's for trial
-:data:`UPRIGHT_TRIAL` (:func:`graspexp.core.seeding.plan_seed`).
+:data:`UPRIGHT_TRIAL` (:func:`graspexp.core.seeding.plan_seed`). :func:`resting_pose` and
+:func:`posed_request` place it turned instead, with another trial's seed (``bench.plan_grasps``).
 """
 
 import time
