@@ -19,8 +19,9 @@ every path above the support) and ``ns/el``, the compiled Eq. (1) kernel alone
 planner's CPU target (:data:`TARGETS_CPU_MS`) and the rows over it. The header gives the float32
 square-root throughput of this machine measured the same way (the bound that kernel runs against: one
 sqrt per element) and what the first plan of the process cost (numba's import came before; its kernels
-come from the on-disk cache or are compiled). Without a dataset's meshes under the data root it falls
-back to the procedural ``primitives`` dataset and says so. Extra ``key=value`` arguments are Hydra
+come from the on-disk cache or are compiled). Without ``objects=[...]`` it times the dataset's objects
+staged under the data root and names the others; without any of its meshes it falls back to the
+procedural ``primitives`` dataset and says so. Extra ``key=value`` arguments are Hydra
 overrides.
 """
 
@@ -37,7 +38,7 @@ import numba  # noqa: E402
 import numpy as np  # noqa: E402
 from threadpoolctl import threadpool_limits  # noqa: E402
 
-from graspexp.datasets import DatasetError, dataset_objects, job_object  # noqa: E402
+from graspexp.datasets import DatasetError, available_objects, dataset_objects, job_object  # noqa: E402
 from graspexp.planning import PlanRequest, kernels, plan  # noqa: E402
 from graspexp.planning.clusters import segment  # noqa: E402
 from graspexp.planning.cost import M_TO_MM  # noqa: E402
@@ -126,14 +127,18 @@ def first_plan_s(req: PlanRequest) -> tuple[float, str]:
 
 def staged_rows(overrides: list[str], prog: str) -> tuple[list[tuple], str, list[str]]:
     """Every (object, mode) request of one planner and dataset (``overrides`` compose them, module doc):
-    rows ``(name, mode, K, area size, request)``, the dataset's name (``primitives`` when its meshes are
+    rows ``(name, mode, area size, request)``, the dataset's name (``primitives`` when its meshes are
     missing) and its note lines."""
     modes, overrides = take_sweep(overrides, "mode", PAPER_MODES)
     cfg = compose_checked(overrides, prog)
     dataset, notes = str(cfg.dataset.name), []
-    names = list(cfg.objects) if cfg.objects else dataset_objects(cfg.dataset)
+    names = list(cfg.objects) if cfg.objects else available_objects(cfg.dataset)
+    if not cfg.objects and (missing := sorted(set(dataset_objects(cfg.dataset)) - set(names))):
+        notes.append(
+            f"note: {dataset}: {len(missing)} objects not staged under the data root: {', '.join(missing)}"
+        )
     try:
-        job_object(cfg, names[0])
+        job_object(cfg, (names or dataset_objects(cfg.dataset))[0])  # none staged: the first one's error
     except DatasetError as err:
         notes.append(f"note: {dataset} meshes unavailable ({err}); falling back to the primitives dataset")
         cfg = compose_checked([*overrides, "dataset=primitives"], prog)
@@ -147,7 +152,7 @@ def staged_rows(overrides: list[str], prog: str) -> tuple[list[tuple], str, list
         for mode in modes:
             cfg.mode.name = mode
             req = upright_request(cfg, model)
-            rows.append((name, mode, plan(req).grasp.extras.get("K", 0), int(model.area_mask.sum()), req))
+            rows.append((name, mode, int(model.area_mask.sum()), req))
     return rows, dataset, notes
 
 
@@ -194,6 +199,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             tables.append((planner, name, rows))
     requests = [req for *_, rows in tables for *_, req in rows]
     first = first_plan_s(requests[0])
+    tables = [  # K of each row's plan
+        (planner, dataset, [(n, m, plan(req).grasp.extras.get("K", 0), a, req) for n, m, a, req in rows])
+        for planner, dataset, rows in tables
+    ]
     with threadpool_limits(limits=1):
         calls = [timed_calls(req) for req in requests]
         sqrt_ns = sqrt_bound_ns(args.repeats)
