@@ -143,16 +143,19 @@ def staged_rows(overrides: list[str], prog: str) -> tuple[list[tuple], str, list
         notes.append(f"note: {dataset} meshes unavailable ({err}); falling back to the primitives dataset")
         cfg = compose_checked([*overrides, "dataset=primitives"], prog)
         dataset, names = "primitives", dataset_objects(cfg.dataset)
+    configs = {
+        mode: compose_checked([*overrides, f"dataset={dataset}", f"mode={mode}"], prog) for mode in modes
+    }
     rows = []
     for name in names:
         try:
             model = job_object(cfg, name)
         except DatasetError as err:
             fail(str(err), prog)
-        for mode in modes:
-            cfg.mode.name = mode
-            req = upright_request(cfg, model)
-            rows.append((name, mode, int(model.area_mask.sum()), req))
+        for (
+            mode
+        ) in modes:  # the mode's own support (height, whether it blocks the gripper), not only its name
+            rows.append((name, mode, int(model.area_mask.sum()), upright_request(configs[mode], model)))
     return rows, dataset, notes
 
 
