@@ -168,21 +168,16 @@ class GripperGeometry:
     def boxes(self, width_m: float) -> np.ndarray:
         """(3, 2, 3) float64 ``[lo, hi]`` corners of the left finger, right finger and palm in the gripper
         frame, pads ``width_m`` apart, m."""
-        return self.boxes_batch(np.array([width_m], dtype=np.float64))[0]
-
-    def boxes_batch(self, widths_m: np.ndarray) -> np.ndarray:
-        """(B, 3, 2, 3) float64: :meth:`boxes` for each of (B,) openings, m."""
         fw, t = self.finger_width_m, self.finger_thickness_m
         px, py, pz = self.palm_size_m
-        root, tip = self.root_z_m, self.tip_z_m
-        h = np.asarray(widths_m, dtype=np.float64) / 2
-        out = np.empty((len(h), 3, 2, 3))
-        out[:, :2, :, 0] = [-fw / 2, fw / 2]
-        out[:, :2, :, 2] = [root, tip]
-        out[:, 0, 0, 1], out[:, 0, 1, 1] = h, h + t
-        out[:, 1, 0, 1], out[:, 1, 1, 1] = -h - t, -h
-        out[:, 2] = [[-px / 2, -py / 2, root - pz], [px / 2, py / 2, root]]
-        return out
+        root, tip, h = self.root_z_m, self.tip_z_m, width_m / 2
+        return np.array(
+            [
+                [[-fw / 2, h, root], [fw / 2, h + t, tip]],
+                [[-fw / 2, -h - t, root], [fw / 2, -h, tip]],
+                [[-px / 2, -py / 2, root - pz], [px / 2, py / 2, root]],
+            ]
+        )
 
 
 def hand_of(g: GripperConfig) -> HandMeshes | None:

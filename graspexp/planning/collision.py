@@ -31,7 +31,7 @@ import numpy as np
 from graspexp.config import GripperConfig
 from graspexp.config.gripper import GripperGeometry
 from graspexp.planning.hull_sweep import hull_cloud_hits, hull_lowest_z
-from graspexp.planning.kernels import COUNT_ALL, swept_box_hits
+from graspexp.planning.kernels import COUNT_ALL, box_lowest_z, swept_box_hits
 from graspexp.planning.pose import slab_spans_m
 
 
@@ -52,11 +52,14 @@ def lowest_z(poses: np.ndarray, gripper: GripperConfig, widths_m: np.ndarray, sw
     geometry = GripperGeometry.of(gripper)
     if geometry.hand is not None:
         return hull_lowest_z(poses, geometry.hand, widths, sweep_m)
-    boxes = geometry.boxes_batch(widths)  # (B, 3, 2, 3)
-    boxes[:, :, 0, 2] -= sweep_m
-    r = poses[:, 2, :3][:, None, None, :]  # (B, 1, 1, 3): row z of each rotation
-    reach = (r * boxes).min(axis=2).sum(axis=-1)  # (B, 3) per box
-    return poses[:, 2, 3] + reach.min(axis=1)
+    px, py, pz = geometry.palm_size_m
+    root = geometry.root_z_m
+    return box_lowest_z(
+        np.ascontiguousarray(poses),
+        np.ascontiguousarray(widths / 2),
+        np.array([geometry.finger_width_m, geometry.finger_thickness_m, root - sweep_m, geometry.tip_z_m]),
+        np.array([px, py, root - pz - sweep_m, root]),
+    )
 
 
 def cloud_hits(
@@ -165,6 +168,18 @@ class Placement:
     too_wide: np.ndarray
     below_support: np.ndarray
     collides: np.ndarray
+
+    def rows(self, index: slice | np.ndarray) -> "Placement":
+        """The placements of the candidates ``index`` selects."""
+        return Placement(
+            poses=self.poses[index],
+            widths_m=self.widths_m[index],
+            lift_m=self.lift_m[index],
+            ok=self.ok[index],
+            too_wide=self.too_wide[index],
+            below_support=self.below_support[index],
+            collides=self.collides[index],
+        )
 
     def counts(self) -> dict[str, int]:
         """Rejections per check, for messages and ``Grasp.extras``."""

@@ -11,7 +11,16 @@ kernels still work, compiled afresh in every process.
 The public wrappers live with their meaning: :func:`graspexp.planning.cost.all_path_costs` and
 :func:`~graspexp.planning.cost.distance_term`, :func:`graspexp.planning.clusters.segment` and
 :func:`~graspexp.planning.clusters.max_radii_m`, :func:`graspexp.planning.pose.grasp_rotations` and
-:func:`~graspexp.planning.pose.slab_spans_m`.
+:func:`~graspexp.planning.pose.slab_spans_m`, :func:`graspexp.planning.collision.cloud_hits` and
+:func:`~graspexp.planning.collision.lowest_z`, :func:`graspexp.planning.stability.pad_contacts` and
+:func:`~graspexp.planning.stability.pad_edge_excess_m`.
+
+The kernels over a batch of grasp frames (the section, the swept boxes, the pads' contacts) see the
+frames ``optimal_plus`` tries for one path and roll as a run of consecutive frames with one rotation,
+moved along their Y and Z axes only: per run one pass over the cloud keeps the points near the frames'
+YZ plane (:func:`_run_cull`), and every frame of the run scans those. The cull only leaves out points the
+exact test would reject, and the exact tests and sums are the same expressions in the same point order,
+so the results are bit for bit those of a scan over every point.
 """
 
 import os
@@ -269,65 +278,215 @@ def slab_spans(
 
     points : (N, 3) float64 world; centers : (B, 3) frame origins; rotations : (B, 3, 3) frame axes as
     columns. Returns (B, 2) float64 relative to each origin, [0, 0] where no point qualifies
-    (:func:`graspexp.planning.pose.slab_spans_m`). Requires finite inputs (fastmath).
+    (:func:`graspexp.planning.pose.slab_spans_m`). Requires finite inputs (fastmath). Consecutive frames
+    with one rotation share one cull of the points (:func:`_run_cull`); a lone frame scans them all.
     """
-    xs = np.ascontiguousarray(points[:, 0])  # structure of arrays: the first pass vectorises
-    ys = np.ascontiguousarray(points[:, 1])
-    zs = np.ascontiguousarray(points[:, 2])
+    xs, ys, zs = _soa(points)  # structure of arrays: the first pass vectorises
+    pts32 = _soa32(points)
     n = xs.shape[0]
     out = np.zeros((rotations.shape[0], 2))
-    big = 1e30  # a finite sentinel: fastmath assumes no inf
     y_lo = np.empty(n)  # y where inside, else +big
     y_hi = np.empty(n)  # y where inside, else -big
-    for b in range(rotations.shape[0]):
-        r = rotations[b]
-        cx, cy, cz = centers[b, 0], centers[b, 1], centers[b, 2]
-        for i in range(n):
-            px, py, pz = xs[i] - cx, ys[i] - cy, zs[i] - cz
-            x = r[0, 0] * px + r[1, 0] * py + r[2, 0] * pz
-            y = r[0, 1] * px + r[1, 1] * py + r[2, 1] * pz
-            z = r[0, 2] * px + r[1, 2] * py + r[2, 2] * pz
-            inside = (abs(x) <= half_width) & (z >= z_lo) & (z <= z_hi)  # no short circuit: selects
-            y_lo[i] = y if inside else big
-            y_hi[i] = y if inside else -big
-        # A second, scalar pass: LLVM does not vectorise float min/max reductions without function-wide
-        # no-NaN attributes, which numba does not set; fused into the first pass they halve its speed.
-        lo, hi = big, -big
-        for i in range(n):
-            lo = y_lo[i] if y_lo[i] < lo else lo
-            hi = y_hi[i] if y_hi[i] > hi else hi
-        if lo <= hi:  # some point was inside
-            out[b, 0] = lo
-            out[b, 1] = hi
+    keep, cull, idx = np.empty(n, dtype=np.bool_), np.empty((3, n)), np.empty(n, dtype=np.int64)
+    box = np.array([[half_width, z_lo, z_hi]])
+    b = 0
+    while b < rotations.shape[0]:
+        if b + 1 == rotations.shape[0] or np.any(rotations[b + 1] != rotations[b]):  # a lone frame
+            _slab_span(xs, ys, zs, n, rotations[b], centers[b], half_width, z_lo, z_hi, y_lo, y_hi, out[b])
+            b += 1
+            continue
+        end, k = _run_cull(pts32, xs, ys, zs, rotations, centers, b, box, keep, cull, idx)
+        for g in range(b, end):
+            _slab_span(
+                cull[0],
+                cull[1],
+                cull[2],
+                k,
+                rotations[g],
+                centers[g],
+                half_width,
+                z_lo,
+                z_hi,
+                y_lo,
+                y_hi,
+                out[g],
+            )
+        b = end
     return out
+
+
+@_jit_fast
+def _slab_span(
+    xs: np.ndarray,
+    ys: np.ndarray,
+    zs: np.ndarray,
+    k: int,
+    r: np.ndarray,
+    c: np.ndarray,
+    half_width: float,
+    z_lo: float,
+    z_hi: float,
+    y_lo: np.ndarray,
+    y_hi: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """:func:`slab_spans` of the first ``k`` points (coordinate arrays, world) in the frame of rotation
+    ``r`` (3, 3) at origin ``c`` (3,), written into ``out`` (2,) where some point is inside; ``y_lo``,
+    ``y_hi`` (N,) are scratch."""
+    big = 1e30  # a finite sentinel: fastmath assumes no inf
+    cx, cy, cz = c[0], c[1], c[2]
+    for i in range(k):
+        px, py, pz = xs[i] - cx, ys[i] - cy, zs[i] - cz
+        x = r[0, 0] * px + r[1, 0] * py + r[2, 0] * pz
+        y = r[0, 1] * px + r[1, 1] * py + r[2, 1] * pz
+        z = r[0, 2] * px + r[1, 2] * py + r[2, 2] * pz
+        inside = (abs(x) <= half_width) & (z >= z_lo) & (z <= z_hi)  # no short circuit: selects
+        y_lo[i] = y if inside else big
+        y_hi[i] = y if inside else -big
+    # A second, scalar pass: LLVM does not vectorise float min/max reductions without function-wide
+    # no-NaN attributes, which numba does not set; fused into the first pass they halve its speed.
+    lo, hi = big, -big
+    for i in range(k):
+        lo = y_lo[i] if y_lo[i] < lo else lo
+        hi = y_hi[i] if y_hi[i] > hi else hi
+    if lo <= hi:  # some point was inside
+        out[0] = lo
+        out[1] = hi
+
+
+SLACK_M = 1e-9
+"""Added to a cull's bound, m: far above the rounding of coordinates below a kilometre, so a point culled
+by :func:`_run_cull` fails the exact test too."""
+
+
+@_jit
+def _soa(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The (N, 3) points as three contiguous (N,) coordinate arrays (structure of arrays: loops vectorise)."""
+    return (
+        np.ascontiguousarray(points[:, 0]),
+        np.ascontiguousarray(points[:, 1]),
+        np.ascontiguousarray(points[:, 2]),
+    )
+
+
+@_jit
+def _rotation_run(rotations: np.ndarray, origins: np.ndarray, b: int) -> tuple[int, float, float, float]:
+    """End (exclusive) of the run of frames from ``b`` whose (3, 3) rotation is bitwise ``rotations[b]``,
+    and how far their origins (B, 3) lie from ``origins[b]`` along that rotation's axes, m: the largest
+    distance along X and the smallest and largest offset along Z (the frames of one path and roll move
+    along their Y and Z axes only)."""
+    r, o = rotations[b], origins[b]
+    end, dx, dz_lo, dz_hi = b + 1, 0.0, 0.0, 0.0
+    while end < rotations.shape[0]:
+        q = rotations[end]
+        same = True
+        for i in range(3):
+            for j in range(3):
+                same = same and q[i, j] == r[i, j]
+        if not same:
+            break
+        d0, d1, d2 = origins[end, 0] - o[0], origins[end, 1] - o[1], origins[end, 2] - o[2]
+        dx = max(dx, abs(r[0, 0] * d0 + r[1, 0] * d1 + r[2, 0] * d2))
+        dz = r[0, 2] * d0 + r[1, 2] * d1 + r[2, 2] * d2
+        dz_lo, dz_hi = min(dz_lo, dz), max(dz_hi, dz)
+        end += 1
+    return end, dx, dz_lo, dz_hi
+
+
+@_jit
+def _soa32(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+    """The (N, 3) points as three float32 coordinate arrays (the cull's pass moves half the bytes and
+    runs twice as wide) and the slack, m, that covers the float32 rounding of a frame coordinate computed
+    from them (:func:`_run_cull`): ``SLACK_M`` plus 1e-6 x the largest coordinate magnitude, generous
+    for float32's 6e-8 relative step."""
+    x32, y32, z32 = (
+        points[:, 0].astype(np.float32),
+        points[:, 1].astype(np.float32),
+        points[:, 2].astype(np.float32),
+    )
+    return x32, y32, z32, SLACK_M + 1e-6 * (np.abs(points).max() if points.shape[0] else 0.0)
+
+
+@_jit
+def _run_cull(
+    pts32: tuple[np.ndarray, np.ndarray, np.ndarray, float],
+    xs: np.ndarray,
+    ys: np.ndarray,
+    zs: np.ndarray,
+    rotations: np.ndarray,
+    origins: np.ndarray,
+    b: int,
+    boxes: np.ndarray,
+    keep: np.ndarray,
+    cull: np.ndarray,
+    idx: np.ndarray,
+) -> tuple[int, int]:
+    """The end of the run of frames from ``b`` (:func:`_rotation_run`) and the count ``k`` of the points
+    (coordinate arrays, world) that may lie, in some frame of the run, in one of the slabs ``boxes``
+    (S, 3), rows [half x, z lo, z hi] (``|x| <= half x``, ``z lo <= z <= z hi``, any y, frame axes, m);
+    their coordinates are copied into the first ``k`` columns of ``cull`` (3, N) and their indices,
+    ascending, into ``idx``. ``keep`` (N,) bool is scratch. The test runs in float32 on ``pts32``
+    (:func:`_soa32`), its bounds those of frame ``b`` grown by the run's offsets, the float32 slack (the
+    origin's magnitude included) and :data:`SLACK_M`: every point left out fails the exact test in every
+    frame."""
+    x32, y32, z32, slack = pts32
+    end, dx, dz_lo, dz_hi = _rotation_run(rotations, origins, b)
+    r, o = rotations[b], origins[b]
+    slack += 1e-6 * max(abs(o[0]), abs(o[1]), abs(o[2]))
+    ax, ay, az = np.float32(r[0, 0]), np.float32(r[1, 0]), np.float32(r[2, 0])
+    cx, cy, cz = np.float32(r[0, 2]), np.float32(r[1, 2]), np.float32(r[2, 2])
+    off_x = np.float32(r[0, 0] * o[0] + r[1, 0] * o[1] + r[2, 0] * o[2])
+    off_z = np.float32(r[0, 2] * o[0] + r[1, 2] * o[1] + r[2, 2] * o[2])
+    keep[: xs.shape[0]] = False
+    for s in range(boxes.shape[0]):
+        x_max = np.float32(boxes[s, 0] + dx + slack)
+        z_min = np.float32(boxes[s, 1] + dz_lo - slack)
+        z_max = np.float32(boxes[s, 2] + dz_hi + slack)
+        for i in range(xs.shape[0]):  # vectorised
+            x = abs(ax * x32[i] + ay * y32[i] + az * z32[i] - off_x)
+            z = cx * x32[i] + cy * y32[i] + cz * z32[i] - off_z
+            keep[i] |= (x <= x_max) & (z >= z_min) & (z <= z_max)
+    k = 0
+    for i in range(xs.shape[0]):  # branch-free: the kept points are spatially mixed
+        idx[k] = i
+        k += keep[i]
+    for j in range(k):
+        i = idx[j]
+        cull[0, j], cull[1, j], cull[2, j] = xs[i], ys[i], zs[i]
+    return end, k
 
 
 @_jit
 def _pad_reach(
     r: np.ndarray,
-    points: np.ndarray,
+    cull: np.ndarray,
+    k: int,
     half_width: float,
     z_lo: float,
     z_hi: float,
     xs: np.ndarray,
     ys: np.ndarray,
     zs: np.ndarray,
-    inside: np.ndarray,
+    y_lo: np.ndarray,
+    y_hi: np.ndarray,
 ) -> tuple[float, float]:
-    """The (N, 3) world ``points`` in the frame of the (4, 4) world pose ``r``, written into ``xs`` (|x|),
-    ``ys``, ``zs`` and ``inside`` (in the pads' reach: ``|x| <= half_width``, ``z_lo <= z <= z_hi``); returns
-    the reach's extreme (lo, hi) along y, (inf, -inf) where no point is in it."""
-    lo, hi = np.inf, -np.inf
-    for i in range(points.shape[0]):
-        px, py, pz = points[i, 0] - r[0, 3], points[i, 1] - r[1, 3], points[i, 2] - r[2, 3]
+    """The first ``k`` world points of ``cull`` (3, N) in the frame of the (4, 4) world pose ``r``, written
+    into ``xs`` (|x|), ``ys`` and ``zs``, and into ``y_lo`` / ``y_hi`` y where the point is in the pads'
+    reach (``|x| <= half_width``, ``z_lo <= z <= z_hi``), else +inf / -inf; returns the reach's extreme
+    (lo, hi) along y, (inf, -inf) where no point is in it."""
+    for i in range(k):  # vectorised
+        px, py, pz = cull[0, i] - r[0, 3], cull[1, i] - r[1, 3], cull[2, i] - r[2, 3]
         x = abs(r[0, 0] * px + r[1, 0] * py + r[2, 0] * pz)
         y = r[0, 1] * px + r[1, 1] * py + r[2, 1] * pz
         z = r[0, 2] * px + r[1, 2] * py + r[2, 2] * pz
-        ok = x <= half_width and z >= z_lo and z <= z_hi
-        xs[i], ys[i], zs[i], inside[i] = x, y, z, ok
-        if ok:
-            lo = min(lo, y)
-            hi = max(hi, y)
+        inside = (x <= half_width) & (z >= z_lo) & (z <= z_hi)
+        xs[i], ys[i], zs[i] = x, y, z
+        y_lo[i] = y if inside else np.inf
+        y_hi[i] = y if inside else -np.inf
+    lo, hi = np.inf, -np.inf
+    for i in range(k):  # selects, no branches
+        lo = y_lo[i] if y_lo[i] < lo else lo
+        hi = y_hi[i] if y_hi[i] > hi else hi
     return lo, hi
 
 
@@ -345,40 +504,55 @@ def pad_contact_stats(
     """Per grasp frame: [depth of the shallower pad's contact from ``z_hi``, larger contact-normal angle to
     the closing axis (rad), smaller share of contact points in ``area``] (:func:`graspexp.planning.
     stability.pad_contacts`). points, normals : (N, 3) world; area : (N,) bool; poses : (B, 4, 4).
-    Returns (B, 3) float64; a side without contact points gives -inf, pi and 0."""
+    Returns (B, 3) float64; a side without contact points gives -inf, pi and 0. Consecutive poses with
+    one rotation share one cull of the points (:func:`_run_cull`); the sums run in point order."""
     n = points.shape[0]
     out = np.empty((poses.shape[0], 3))
-    xs, ys, zs = np.empty(n), np.empty(n), np.empty(n)
-    inside = np.zeros(n, dtype=np.bool_)
-    for b in range(poses.shape[0]):
-        r = poses[b]
-        lo, hi = _pad_reach(r, points, half_width, z_lo, z_hi, xs, ys, zs, inside)
-        depth, angle, share = np.inf, 0.0, 1.0
-        for sign in (1.0, -1.0):
-            count, in_area, sum_z, ny = 0, 0, 0.0, 0.0
-            nx_, nz_ = 0.0, 0.0
-            for i in range(n):
-                if not inside[i]:
-                    continue
-                if (sign > 0 and ys[i] >= hi - band) or (sign < 0 and ys[i] <= lo + band):
-                    count += 1
-                    in_area += area[i]
-                    sum_z += zs[i]
-                    # the normal in the grasp frame: R^T n
-                    nx_ += r[0, 0] * normals[i, 0] + r[1, 0] * normals[i, 1] + r[2, 0] * normals[i, 2]
-                    ny += r[0, 1] * normals[i, 0] + r[1, 1] * normals[i, 1] + r[2, 1] * normals[i, 2]
-                    nz_ += r[0, 2] * normals[i, 0] + r[1, 2] * normals[i, 1] + r[2, 2] * normals[i, 2]
-            if count == 0:
-                depth, angle, share = -np.inf, np.pi, 0.0
+    px, py, pz = _soa(points)
+    pts32 = _soa32(points)
+    keep, cull, idx = np.empty(n, dtype=np.bool_), np.empty((3, n)), np.empty(n, dtype=np.int64)
+    xs, ys, zs, y_lo, y_hi = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    box = np.array([[half_width, z_lo, z_hi]])
+    b = 0
+    while b < poses.shape[0]:
+        end, k = _run_cull(pts32, px, py, pz, poses[:, :3, :3], poses[:, :3, 3], b, box, keep, cull, idx)
+        for g in range(b, end):
+            r = poses[g]
+            lo, hi = _pad_reach(r, cull, k, half_width, z_lo, z_hi, xs, ys, zs, y_lo, y_hi)
+            if lo > hi:
+                out[g, 0], out[g, 1], out[g, 2] = -np.inf, np.pi, 0.0
                 continue
-            depth = min(depth, z_hi - sum_z / count)
-            length = np.sqrt(nx_ * nx_ + ny * ny + nz_ * nz_)
-            a = np.pi if length == 0 else np.arccos(min(max(sign * ny / length, -1.0), 1.0))
-            angle = max(angle, a)
-            share = min(share, in_area / count)
-        out[b, 0] = depth
-        out[b, 1] = angle
-        out[b, 2] = share
+            sums = np.zeros((2, 6))  # per pad (left: +Y, right: -Y): count, in area, z, normal x, y, z
+            for j in range(k):  # both pads in one pass, each summed in point order
+                left, right = y_hi[j] >= hi - band, y_lo[j] <= lo + band
+                if not (left or right):
+                    continue
+                i = idx[j]
+                # the normal in the grasp frame: R^T n
+                nx = r[0, 0] * normals[i, 0] + r[1, 0] * normals[i, 1] + r[2, 0] * normals[i, 2]
+                ny = r[0, 1] * normals[i, 0] + r[1, 1] * normals[i, 1] + r[2, 1] * normals[i, 2]
+                nz = r[0, 2] * normals[i, 0] + r[1, 2] * normals[i, 1] + r[2, 2] * normals[i, 2]
+                for side, hit in ((0, left), (1, right)):
+                    if hit:
+                        sums[side, 0] += 1
+                        sums[side, 1] += area[i]
+                        sums[side, 2] += zs[j]
+                        sums[side, 3] += nx
+                        sums[side, 4] += ny
+                        sums[side, 5] += nz
+            depth, angle, share = np.inf, 0.0, 1.0
+            for side, sign in ((0, 1.0), (1, -1.0)):
+                count, in_area, sum_z, nx_, ny, nz_ = sums[side]
+                if count == 0:
+                    depth, angle, share = -np.inf, np.pi, 0.0
+                    continue
+                depth = min(depth, z_hi - sum_z / count)
+                length = np.sqrt(nx_ * nx_ + ny * ny + nz_ * nz_)
+                a = np.pi if length == 0 else np.arccos(min(max(sign * ny / length, -1.0), 1.0))
+                angle = max(angle, a)
+                share = min(share, in_area / count)
+            out[g, 0], out[g, 1], out[g, 2] = depth, angle, share
+        b = end
     return out
 
 
@@ -398,11 +572,10 @@ def pad_edge_excess(
     point lies there or no point is in the pads' reach."""
     n = points.shape[0]
     out = np.full(poses.shape[0], -np.inf)
-    xs, ys, zs = np.empty(n), np.empty(n), np.empty(n)
-    inside = np.zeros(n, dtype=np.bool_)
+    cull = np.ascontiguousarray(points.T)
+    xs, ys, zs, y_lo, y_hi = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     for b in range(poses.shape[0]):
-        r = poses[b]
-        lo, hi = _pad_reach(r, points, half_width, z_lo, z_hi, xs, ys, zs, inside)
+        lo, hi = _pad_reach(poses[b], cull, n, half_width, z_lo, z_hi, xs, ys, zs, y_lo, y_hi)
         if lo > hi:
             continue
         worst = -np.inf
@@ -423,6 +596,35 @@ COUNT_ALL = np.iinfo(np.int64).max
 """``stop_at`` of the swept-volume kernels that counts every point (no early stop)."""
 
 
+BOX_BLOCK = 128
+"""Points counted per vectorised block of :func:`_box_hits` before the ``stop_at`` test."""
+
+
+@_jit
+def _box_hits(
+    cull: np.ndarray, k: int, r: np.ndarray, h: float, finger: np.ndarray, palm: np.ndarray, stop_at: int
+) -> int:
+    """Points among the first ``k`` of ``cull`` (3, N) world inside the swept boxes of the (4, 4) pose
+    ``r`` with half opening ``h`` (:func:`swept_box_hits`), counted up to ``stop_at``: branch-free blocks
+    of :data:`BOX_BLOCK` points (vectorised), the test after each block."""
+    fx, ft, fz0, fz1, m = finger[0], finger[1], finger[2], finger[3], finger[4]
+    px, py, pz0, pz1 = palm[0], palm[1], palm[2], palm[3]
+    y0, y1 = h - m, h + ft + m
+    count = 0
+    for s in range(0, k, BOX_BLOCK):
+        for i in range(s, min(s + BOX_BLOCK, k)):
+            qx, qy, qz = cull[0, i] - r[0, 3], cull[1, i] - r[1, 3], cull[2, i] - r[2, 3]
+            z = r[0, 2] * qx + r[1, 2] * qy + r[2, 2] * qz
+            x = abs(r[0, 0] * qx + r[1, 0] * qy + r[2, 0] * qz)
+            y = abs(r[0, 1] * qx + r[1, 1] * qy + r[2, 1] * qz)
+            in_finger = (x <= fx) & (fz0 <= z) & (z <= fz1) & (y0 <= y) & (y <= y1)
+            in_palm = (x <= px) & (y <= py) & (pz0 <= z) & (z <= pz1)
+            count += in_finger | in_palm
+        if count >= stop_at:
+            return stop_at
+    return count
+
+
 @_jit
 def swept_box_hits(
     points: np.ndarray,
@@ -435,29 +637,45 @@ def swept_box_hits(
     """Points inside the swept finger and palm boxes of each grasp (:func:`graspexp.planning.collision.
     cloud_hits`). points : (N, 3) world; poses : (B, 4, 4); half_widths : (B,) half openings, m;
     finger : [half x, thickness, z lo, z hi, margin]; palm : [half x, half y, z lo, z hi], margin included
-    except in ``finger``'s y bounds; a grasp's count stops at ``stop_at`` (1: is it free?). Returns (B,)
-    int64."""
+    except in ``finger``'s y bounds; a grasp's count stops at ``stop_at`` (1: is it free?). Consecutive
+    poses with one rotation share one cull of the points (:func:`_run_cull`, by the finger and palm slabs).
+    Returns (B,) int64."""
+    n = points.shape[0]
     out = np.zeros(poses.shape[0], dtype=np.int64)
-    fx, ft, fz0, fz1, m = finger[0], finger[1], finger[2], finger[3], finger[4]
-    px, py, pz0, pz1 = palm[0], palm[1], palm[2], palm[3]
+    xs, ys, zs = _soa(points)
+    pts32 = _soa32(points)
+    keep, cull, idx = np.empty(n, dtype=np.bool_), np.empty((3, n)), np.empty(n, dtype=np.int64)
+    boxes = np.array([[finger[0], finger[2], finger[3]], [palm[0], palm[2], palm[3]]])
+    b = 0
+    while b < poses.shape[0]:
+        end, k = _run_cull(pts32, xs, ys, zs, poses[:, :3, :3], poses[:, :3, 3], b, boxes, keep, cull, idx)
+        for g in range(b, end):
+            out[g] = _box_hits(cull, k, poses[g], half_widths[g], finger, palm, stop_at)
+        b = end
+    return out
+
+
+@_jit
+def box_lowest_z(
+    poses: np.ndarray, half_widths: np.ndarray, finger: np.ndarray, palm: np.ndarray
+) -> np.ndarray:
+    """Lowest world z of the swept finger and palm boxes of each grasp (:func:`graspexp.planning.collision.
+    lowest_z`): per box ``t_z + sum_a min(R[2, a] lo_a, R[2, a] hi_a)`` summed over a = x, y, z in order,
+    the smallest of the three boxes. poses : (B, 4, 4); half_widths : (B,) half openings, m;
+    finger : [width, thickness, z lo, z hi]; palm : [x, y, z lo, z hi] (sizes, not halves), z lo swept.
+    Returns (B,) float64, m."""
+    out = np.empty(poses.shape[0])
+    fx, ft = finger[0] / 2, finger[1]
+    px, py = palm[0] / 2, palm[1] / 2
     for b in range(poses.shape[0]):
-        r = poses[b]
+        r0, r1, r2 = poses[b, 2, 0], poses[b, 2, 1], poses[b, 2, 2]
         h = half_widths[b]
-        count = 0
-        for i in range(points.shape[0]):
-            qx, qy, qz = points[i, 0] - r[0, 3], points[i, 1] - r[1, 3], points[i, 2] - r[2, 3]
-            z = r[0, 2] * qx + r[1, 2] * qy + r[2, 2] * qz
-            if z > fz1 and z > pz1:
-                continue
-            x = abs(r[0, 0] * qx + r[1, 0] * qy + r[2, 0] * qz)
-            y = abs(r[0, 1] * qx + r[1, 1] * qy + r[2, 1] * qz)
-            in_finger = x <= fx and fz0 <= z <= fz1 and h - m <= y <= h + ft + m
-            in_palm = x <= px and y <= py and pz0 <= z <= pz1
-            if in_finger or in_palm:
-                count += 1
-                if count >= stop_at:
-                    break
-        out[b] = count
+        sx = min(r0 * -fx, r0 * fx)
+        sz = min(r2 * finger[2], r2 * finger[3])
+        left = sx + min(r1 * h, r1 * (h + ft)) + sz
+        right = sx + min(r1 * (-h - ft), r1 * -h) + sz
+        base = min(r0 * -px, r0 * px) + min(r1 * -py, r1 * py) + min(r2 * palm[2], r2 * palm[3])
+        out[b] = poses[b, 2, 3] + min(min(left, right), base)
     return out
 
 

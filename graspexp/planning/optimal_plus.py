@@ -53,13 +53,15 @@ shortlisted paths' ``shortlist_poses`` (S, 4, 4), ``shortlist_widths`` (S,) m, `
 (:mod:`graspexp.tools.bench.shortlist` simulates each of them).
 """
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from graspexp.config.gripper import GripperGeometry
 from graspexp.core.geometry import transform_points
 from graspexp.core.seeding import rng_for
 from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
-from graspexp.planning.collision import cloud_hits, place_for_request
+from graspexp.planning.collision import Placement, cloud_hits, place_for_request
 from graspexp.planning.friction import cone_cosine
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.optimal import paper_candidates
@@ -76,7 +78,11 @@ from graspexp.planning.stability import (
 NAME = "optimal_plus"
 
 PATH_BATCH = 16
-"""Paths examined together, in ascending paper cost."""
+"""Paths examined together, in ascending paper cost: the search stops after the batch in which
+``shortlist`` paths have passed."""
+MAX_CHUNK = 64
+"""Most paths whose tries are evaluated in one array pass (:class:`_Tries`), a multiple of
+:data:`PATH_BATCH`."""
 
 
 def _check_params(pl) -> None:
@@ -108,13 +114,12 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
         floors = opening_widths_m(cand.clusters.radii_m, pl.width_margin, gr)
     else:
         floors = np.zeros(k)
-    passed, rejected, examined, best_share = _search_paths(
-        req, cand, geometry, floors, pl.min_contacts_in_area
-    )
+    tries = _Tries(req, cand, geometry, floors)
+    passed, rejected, examined, best_share = _search_paths(pl, tries, pl.min_contacts_in_area)
     in_area_required = pl.min_contacts_in_area
     if not passed and (share := fallback_share(req, best_share)) is not None:  # step 6 of the module doc
         in_area_required = share
-        passed = _search_paths(req, cand, geometry, floors, share)[0]
+        passed = _search_paths(pl, tries, share)[0]
     if not passed:
         raise NoFeasibleGrasp(
             f"optimal_plus: all {examined} paths above the support failed at every depth: "
@@ -196,54 +201,111 @@ def pick_shortlisted(choose_by: str, costs: np.ndarray, robust: np.ndarray, exce
     return int(np.argmin(np.where(robust, costs, np.inf)))
 
 
-def _search_paths(
-    req: PlanRequest, cand, geometry: GripperGeometry, floors: np.ndarray, min_share: float
-) -> tuple[list[tuple], dict[str, int], int, float]:
-    """Steps 1-3 of the module doc over the paper's paths in ascending cost, requiring ``min_share`` of
-    each pad's contact in the area: the passing paths ``(k, p, pose, width, depth, offset, roll_deg)``
-    (up to ``shortlist``), the rejection counts, the number of paths examined and the largest in-area
-    share among the tries that pass everything but the area test (0 if none)."""
-    pl = req.planner
-    points, directions, centers = cand.points, cand.directions, cand.clusters.centers_m
-    normals = np.asarray(req.normals, dtype=np.float64)
-    k, m = cand.costs.shape
-    offsets = np.asarray(pl.depth_offsets_m, dtype=np.float64)
-    rolls = [_roll(np.deg2rad(r)) for r in pl.rolls_deg]
-    n_roll, n_off = len(rolls), len(offsets)
+@dataclass(frozen=True)
+class _Batch:
+    """Steps 1-3 of the module doc, all but the area test, for the tries of :data:`PATH_BATCH` paths.
+
+    ks, ps : (B,) cluster and path of each path; placed : the (B * R * O) tries placed (step 2), path-major,
+    then roll (R), then depth offset (O); held : (B * R * O,) bool, the placed tries passing step 3 but
+    for the area test; depth_m, share : (B * R * O,) pad depth, m (-inf where not placed) and in-area share
+    (0 where not placed)."""
+
+    ks: np.ndarray
+    ps: np.ndarray
+    placed: Placement
+    held: np.ndarray
+    depth_m: np.ndarray
+    share: np.ndarray
+
+
+class _Tries:
+    """The tries of the paper's paths in ascending cost (module doc, steps 1-3 but the area test), evaluated
+    on demand and kept: a fallback search (step 7) reads them again. Paths are evaluated in chunks that
+    grow with the search (:data:`PATH_BATCH` up to :data:`MAX_CHUNK` paths), so a long search makes few
+    array passes; each chunk is kept as :class:`_Batch` es of :data:`PATH_BATCH` paths."""
+
+    def __init__(self, req: PlanRequest, cand, geometry: GripperGeometry, floors: np.ndarray):
+        pl = req.planner
+        self.req, self.cand, self.geometry, self.floors = req, cand, geometry, floors
+        self.offsets = np.asarray(pl.depth_offsets_m, dtype=np.float64)
+        self.rolls = [_roll(np.deg2rad(r)) for r in pl.rolls_deg]
+        self.order = np.argsort(cand.costs, axis=None, kind="stable")[: int(cand.feasible.sum())]
+        self.n_batches = -(-len(self.order) // PATH_BATCH)
+        self.batches: list[_Batch] = []
+
+    def batch(self, i: int) -> _Batch:
+        """The ``i``-th batch of :data:`PATH_BATCH` paths (``i < n_batches``)."""
+        while len(self.batches) <= i:
+            done = len(self.batches) * PATH_BATCH
+            size = min(max(done, PATH_BATCH), MAX_CHUNK)
+            self._evaluate(self.order[done : done + size])
+        return self.batches[i]
+
+    def _evaluate(self, chunk: np.ndarray) -> None:
+        """Place and test the tries of the paths ``chunk`` (flat indices into the (K, M) costs); append
+        their batches."""
+        req, cand, offsets = self.req, self.cand, self.offsets
+        pl = req.planner
+        n_roll, n_off = len(self.rolls), len(offsets)
+        ks, ps = np.unravel_index(chunk, cand.costs.shape)
+        b, centers = len(ks), cand.clusters.centers_m
+        rots = grasp_rotations(cand.directions[ks, ps], cand.pose_axis)  # (B, 3, 3)
+        poses = np.tile(np.eye(4), (b, n_roll, n_off, 1, 1))
+        for r, roll in enumerate(self.rolls):
+            poses[:, r, :, :3, :3] = (rots @ roll)[:, None]
+        poses[..., :3, 3] = (
+            centers[ks][:, None, None] + offsets[None, None, :, None] * rots[:, None, None, :, 2]
+        )
+        placed = place_for_request(req, poses.reshape(-1, 4, 4), np.repeat(self.floors[ks], n_roll * n_off))
+        depth = np.full(len(placed.ok), -np.inf)
+        held = np.zeros(len(placed.ok), dtype=bool)
+        share = np.zeros(len(placed.ok))
+        if placed.ok.any():
+            normals = np.asarray(req.normals, dtype=np.float64)
+            held[placed.ok], depth[placed.ok], share[placed.ok] = _pads_hold(
+                pl, self.geometry, cand.points, normals, cand.area_mask, placed.poses[placed.ok]
+            )
+        held &= placed.ok
+        per = n_roll * n_off
+        for s in range(0, b, PATH_BATCH):
+            t = slice(s * per, (s + PATH_BATCH) * per)
+            self.batches.append(
+                _Batch(
+                    ks[s : s + PATH_BATCH],
+                    ps[s : s + PATH_BATCH],
+                    placed.rows(t),
+                    held[t],
+                    depth[t],
+                    share[t],
+                )
+            )
+
+
+def _search_paths(pl, tries: _Tries, min_share: float) -> tuple[list[tuple], dict[str, int], int, float]:
+    """Steps 1-3 of the module doc over the paper's paths in ascending cost, in batches of
+    :data:`PATH_BATCH`, requiring ``min_share`` of each pad's contact in the area: the passing paths
+    ``(k, p, pose, width, depth, offset, roll_deg)`` (up to ``shortlist``), the rejection counts, the
+    number of paths examined and the largest in-area share among the tries that pass everything but the
+    area test (0 if none)."""
+    offsets = tries.offsets
+    n_roll, n_off = len(tries.rolls), len(offsets)
     by_offset = np.argsort(np.abs(offsets), kind="stable")  # tie-break: the smallest move
-    order = np.argsort(cand.costs, axis=None, kind="stable")[: int(cand.feasible.sum())]
     rejected = dict.fromkeys(
         ("n_too_wide", "n_below_support", "n_collides", "n_weak_contact", "n_outside_area"), 0
     )
     passed: list[tuple] = []
     examined, best_share = 0, 0.0
-    for s in range(0, len(order), PATH_BATCH):
-        ks, ps = np.unravel_index(order[s : s + PATH_BATCH], (k, m))
-        examined += len(ks)
-        b = len(ks)
-        rots = grasp_rotations(directions[ks, ps], cand.pose_axis)  # (B, 3, 3)
-        poses = np.tile(np.eye(4), (b, n_roll, n_off, 1, 1))
-        for r, roll in enumerate(rolls):
-            poses[:, r, :, :3, :3] = (rots @ roll)[:, None]
-        poses[..., :3, 3] = (
-            centers[ks][:, None, None] + offsets[None, None, :, None] * rots[:, None, None, :, 2]
-        )
-        placed = place_for_request(req, poses.reshape(-1, 4, 4), np.repeat(floors[ks], n_roll * n_off))
-        depth = np.full(len(placed.ok), -np.inf)
-        held = np.zeros(len(placed.ok), dtype=bool)
-        share = np.zeros(len(placed.ok))
-        if placed.ok.any():
-            held[placed.ok], depth[placed.ok], share[placed.ok] = _pads_hold(
-                pl, geometry, points, normals, cand.area_mask, placed.poses[placed.ok]
-            )
-        held &= placed.ok
-        ok, n_outside, batch_best = area_test(held, share, min_share)
-        for key, n in placed.counts().items():
-            rejected[key] += n
-        rejected["n_weak_contact"] += int((placed.ok & ~held).sum())
+    for n in range(tries.n_batches):
+        batch = tries.batch(n)
+        b = len(batch.ks)
+        examined += b
+        ok, n_outside, batch_best = area_test(batch.held, batch.share, min_share)
+        for key, count in batch.placed.counts().items():
+            rejected[key] += count
+        rejected["n_weak_contact"] += int((batch.placed.ok & ~batch.held).sum())
         rejected["n_outside_area"] += n_outside
         best_share = max(best_share, batch_best)
-        ok, depth = ok.reshape(b, n_roll, n_off), depth.reshape(b, n_roll, n_off)
+        ok, depth = ok.reshape(b, n_roll, n_off), batch.depth_m.reshape(b, n_roll, n_off)
         # per path: the first roll with a passing try, then the target depth with the smallest move
         for i in np.flatnonzero(ok.any(axis=(1, 2))):
             r = int(np.argmax(ok[i].any(axis=1)))
@@ -252,10 +314,10 @@ def _search_paths(
             f = (i * n_roll + r) * n_off + j
             passed.append(
                 (
-                    int(ks[i]),
-                    int(ps[i]),
-                    placed.poses[f],
-                    float(placed.widths_m[f]),
+                    int(batch.ks[i]),
+                    int(batch.ps[i]),
+                    batch.placed.poses[f],
+                    float(batch.placed.widths_m[f]),
                     float(depth[i, r, j]),
                     float(offsets[j]),
                     float(pl.rolls_deg[r]),

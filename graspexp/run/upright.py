@@ -3,7 +3,8 @@ and the planner bench show (no simulation; the object is not dropped).
 
 The pose is the identity rotation translated so that the mesh's lowest point sits on
 ``z = mode.support_height_m`` (x = y = 0). The plan's seed is the runner's for trial
-:data:`UPRIGHT_TRIAL` (:func:`graspexp.core.seeding.plan_seed`).
+:data:`UPRIGHT_TRIAL` (:func:`graspexp.core.seeding.plan_seed`). :func:`resting_pose` and
+:func:`posed_request` place it turned instead, with another trial's seed (``bench.plan_grasps``).
 """
 
 import time
@@ -43,9 +44,25 @@ def upright_pose(model: ObjectModel, support_height_m: float) -> np.ndarray:
     return pose
 
 
+def resting_pose(model: ObjectModel, rotation: np.ndarray, support_height_m: float) -> np.ndarray:
+    """(4,4) world pose of ``model`` turned by the (3,3) ``rotation``, its mesh's box centred on x = y = 0
+    and its lowest point on ``z = support_height_m`` (m)."""
+    v = model.mesh.vertices @ np.asarray(rotation).T
+    pose = np.eye(4)
+    pose[:3, :3] = rotation
+    pose[:2, 3] = -(v[:, :2].min(axis=0) + v[:, :2].max(axis=0)) / 2
+    pose[2, 3] = support_height_m - float(np.min(v[:, 2]))
+    return pose
+
+
 def upright_request(cfg: Any, model: ObjectModel) -> PlanRequest:
     """The planning request for ``model`` standing upright on the support of job config ``cfg``."""
-    pose = upright_pose(model, float(cfg.mode.support_height_m))
+    return posed_request(cfg, model, upright_pose(model, float(cfg.mode.support_height_m)), UPRIGHT_TRIAL)
+
+
+def posed_request(cfg: Any, model: ObjectModel, pose: np.ndarray, trial: int) -> PlanRequest:
+    """The planning request for ``model`` at the (4,4) world ``pose`` (seen without error) on the support
+    of job config ``cfg``, with the planner seed of trial ``trial``."""
     return PlanRequest(
         points=model.points @ pose[:3, :3].T + pose[:3, 3],
         normals=model.normals @ pose[:3, :3].T,
@@ -56,7 +73,7 @@ def upright_request(cfg: Any, model: ObjectModel) -> PlanRequest:
         gripper=OmegaConf.to_object(cfg.gripper),
         planner=OmegaConf.to_object(cfg.planner),
         cost=OmegaConf.to_object(cfg.cost),
-        seed=plan_seed(trial_seed(cfg, model.name, UPRIGHT_TRIAL)),
+        seed=plan_seed(trial_seed(cfg, model.name, trial)),
         support_blocks_gripper=bool(cfg.mode.support_collides_with_gripper),
     )
 

@@ -20,5 +20,6 @@ TOOLS: tuple[str, ...] = (
     "bench.collision_shapes",
     "bench.shortlist",
     "bench.compare_runs",
+    "bench.plan_grasps",
 )
 """Every tool: ``python -m graspexp NAME`` runs ``graspexp.tools.NAME.main``."""

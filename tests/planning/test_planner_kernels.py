@@ -16,8 +16,10 @@ from graspexp.config.gripper import GripperGeometry
 from graspexp.datasets import available_objects, load_object
 from graspexp.planning import NoFeasibleGrasp, PlanRequest, plan
 from graspexp.planning.clusters import KMEANS_MAX_ITER, KMEANS_TOL, Clusters, max_radii_m, segment
+from graspexp.planning.collision import cloud_hits
 from graspexp.planning.cost import all_path_costs, distance_term
 from graspexp.planning.pose import grasp_rotations, slab_spans_m
+from graspexp.planning.stability import pad_contacts
 from graspexp.run.upright import upright_pose
 
 COST = CostConfig()
@@ -126,6 +128,54 @@ def test_slab_kernel_matches_the_numpy_twin_on_random_frames():
     got = slab_spans_m(pts, centers, rots, RG2)
     np.testing.assert_allclose(got, slab_spans_reference(pts, centers, rots, RG2), atol=1e-15)
     assert (got[:, 1] > got[:, 0]).all()  # every frame holds points
+
+
+def _runs_of_tries(rng: np.random.Generator, n_paths: int) -> np.ndarray:
+    """(n_paths * 7, 4, 4) frames as optimal_plus tries them: per path one rotation, 7 depths along its Z,
+    each moved along its Y (centring) by its own amount."""
+    rots = grasp_rotations(rng.normal(size=(n_paths, 3)), np.array([0.0, 0.0, 1.0]))
+    poses = np.tile(np.eye(4), (n_paths, 7, 1, 1))
+    poses[:, :, :3, :3] = rots[:, None]
+    depth = np.linspace(-0.02, 0.04, 7)[None, :, None] * rots[:, None, :, 2]
+    side = rng.normal(size=(n_paths, 7, 1)) * 0.01 * rots[:, None, :, 1]
+    poses[:, :, :3, 3] = rng.normal(size=(n_paths, 1, 3)) * 0.02 + depth + side
+    return poses.reshape(-1, 4, 4)
+
+
+def test_runs_of_one_rotation_give_each_frame_s_own_results_bit_for_bit():
+    """The kernels cull the cloud once per run of frames with one rotation (kernels module doc): batched
+    runs give, bit for bit, what each frame gives alone, and the swept-box counts equal a numpy count."""
+    rng = np.random.default_rng(5)
+    normals = rng.normal(size=(3000, 3))
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    pts = normals * [0.04, 0.03, 0.05]  # an ellipsoid's surface (its normals only roughly: enough here)
+    area = rng.random(3000) < 0.8
+    poses = _runs_of_tries(rng, 30)
+    widths = rng.uniform(0.0, 0.11, len(poses))
+    geometry = GripperGeometry.of(RG2)
+    rots, centers = poses[:, :3, :3], poses[:, :3, 3]
+    one = [slab_spans_m(pts, centers[i : i + 1], rots[i : i + 1], RG2, 0.002) for i in range(len(poses))]
+    np.testing.assert_array_equal(slab_spans_m(pts, centers, rots, RG2, 0.002), np.concatenate(one))
+    pads = np.stack(pad_contacts(pts, normals, poses, geometry, 0.004, area), axis=1)
+    alone = [
+        np.stack(pad_contacts(pts, normals, poses[i : i + 1], geometry, 0.004, area), axis=1)
+        for i in range(len(poses))
+    ]
+    np.testing.assert_array_equal(pads, np.concatenate(alone))
+    assert np.isfinite(pads[:, 0]).sum() > len(poses) // 2  # most frames have both pads' contacts
+    counts = cloud_hits(pts, poses, RG2, widths, sweep_m=0.1, margin_m=0.002)
+    local = np.einsum("bji,bnj->bni", rots, pts[None] - centers[:, None])
+    x, y, z = np.abs(local[..., 0]), np.abs(local[..., 1]), local[..., 2]
+    fw, t, m = geometry.finger_width_m / 2 + 0.002, geometry.finger_thickness_m, 0.002
+    px, py, pz = geometry.palm_size_m
+    h = widths[:, None] / 2
+    root, tip = geometry.root_z_m, geometry.tip_z_m
+    finger = (x <= fw) & (z >= root - 0.1 - m) & (z <= tip + m) & (y >= h - m) & (y <= h + t + m)
+    palm = (x <= px / 2 + m) & (y <= py / 2 + m) & (z >= root - pz - 0.1 - m) & (z <= root + m)
+    np.testing.assert_array_equal(counts, (finger | palm).sum(axis=1))
+    assert 0 < (counts == 0).sum() < len(poses)  # free and colliding frames both
+    free = cloud_hits(pts, poses, RG2, widths, sweep_m=0.1, margin_m=0.002, stop_at=1)
+    np.testing.assert_array_equal(free, np.minimum(counts, 1))
 
 
 def test_kmeans_kernel_matches_the_numpy_twin_on_blobs():

@@ -144,3 +144,18 @@ def test_plan_latency_bench_prints_a_row_per_object_and_mode(capsys):
         assert 0 < wall50 <= wall95 and 0 < cpu50 <= cpu95 and all(v > 0 for v in rest), r
     assert "first plan of this process:" in out[1] and "ns/element" in out[1]
     assert out[-1].startswith("median p50 over objects and modes: CPU") and f"of {len(rows)} over" in out[-1]
+
+
+def test_plan_latency_bench_prints_a_table_per_planner_with_its_cpu_target(capsys):
+    from graspexp.tools.bench.plan_latency import main
+
+    argv = ["--repeats", "1", "--runs", "2", "dataset=primitives", "objects=[can]", "mode=collab"]
+    assert main([*argv, "planner=optimal,optimal_plus"]) == 0
+    out = capsys.readouterr().out
+    assert (
+        "\noptimal, primitives, N=2048 M=256:\n" in out
+        and "\noptimal_plus, primitives, N=4096 M=256:\n" in out
+    )
+    assert [ln.split()[:2] for ln in out.splitlines() if ln.startswith("can ")] == [["can", "collab"]] * 2
+    assert "of 1 over the CPU target (p50 <= 2.5 ms and p95 <= 5 ms)" in out
+    assert "of 1 over the CPU target (p95 <= 50 ms)" in out
