@@ -423,7 +423,7 @@ def _run_cull(
 ) -> tuple[int, int]:
     """The end of the run of frames from ``b`` (:func:`_rotation_run`) and the count ``k`` of the points
     (coordinate arrays, world) that may lie, in some frame of the run, in one of the slabs ``boxes``
-    (S, 3), rows [half x, z lo, z hi] (``|x| <= half x``, ``z lo <= z <= z hi``, any y, frame axes, m);
+    (S, 3), S = 1 or 2, rows [half x, z lo, z hi] (``|x| <= half x``, ``z lo <= z <= z hi``, any y, frame axes, m);
     their coordinates are copied into the first ``k`` columns of ``cull`` (3, N) and their indices,
     ascending, into ``idx``. ``keep`` (N,) bool is scratch. The test runs in float32 on ``pts32``
     (:func:`_soa32`), its bounds those of frame ``b`` grown by the run's offsets, the float32 slack (the
@@ -437,15 +437,14 @@ def _run_cull(
     cx, cy, cz = np.float32(r[0, 2]), np.float32(r[1, 2]), np.float32(r[2, 2])
     off_x = np.float32(r[0, 0] * o[0] + r[1, 0] * o[1] + r[2, 0] * o[2])
     off_z = np.float32(r[0, 2] * o[0] + r[1, 2] * o[1] + r[2, 2] * o[2])
-    keep[: xs.shape[0]] = False
-    for s in range(boxes.shape[0]):
-        x_max = np.float32(boxes[s, 0] + dx + slack)
-        z_min = np.float32(boxes[s, 1] + dz_lo - slack)
-        z_max = np.float32(boxes[s, 2] + dz_hi + slack)
-        for i in range(xs.shape[0]):  # vectorised
-            x = abs(ax * x32[i] + ay * y32[i] + az * z32[i] - off_x)
-            z = cx * x32[i] + cy * y32[i] + cz * z32[i] - off_z
-            keep[i] |= (x <= x_max) & (z >= z_min) & (z <= z_max)
+    last = boxes.shape[0] - 1  # one slab or two: a single slab is tested twice
+    x0, x1 = np.float32(boxes[0, 0] + dx + slack), np.float32(boxes[last, 0] + dx + slack)
+    z0_lo, z1_lo = np.float32(boxes[0, 1] + dz_lo - slack), np.float32(boxes[last, 1] + dz_lo - slack)
+    z0_hi, z1_hi = np.float32(boxes[0, 2] + dz_hi + slack), np.float32(boxes[last, 2] + dz_hi + slack)
+    for i in range(xs.shape[0]):  # vectorised; both slabs from one pair of frame coordinates
+        x = abs(ax * x32[i] + ay * y32[i] + az * z32[i] - off_x)
+        z = cx * x32[i] + cy * y32[i] + cz * z32[i] - off_z
+        keep[i] = ((x <= x0) & (z >= z0_lo) & (z <= z0_hi)) | ((x <= x1) & (z >= z1_lo) & (z <= z1_hi))
     k = 0
     for i in range(xs.shape[0]):  # branch-free: the kept points are spatially mixed
         idx[k] = i
