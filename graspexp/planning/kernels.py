@@ -511,6 +511,7 @@ def pad_contact_stats(
     pts32 = _soa32(points)
     keep, cull, idx = np.empty(n, dtype=np.bool_), np.empty((3, n)), np.empty(n, dtype=np.int64)
     xs, ys, zs, y_lo, y_hi = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    contact, hits = np.empty(n, dtype=np.uint8), np.empty(n, dtype=np.int64)  # a frame's contact points
     box = np.array([[half_width, z_lo, z_hi]])
     b = 0
     while b < poses.shape[0]:
@@ -521,11 +522,17 @@ def pad_contact_stats(
             if lo > hi:
                 out[g, 0], out[g, 1], out[g, 2] = -np.inf, np.pi, 0.0
                 continue
+            left_from, right_to = hi - band, lo + band
+            for j in range(k):  # vectorised
+                contact[j] = (y_hi[j] >= left_from) | (y_lo[j] <= right_to)
+            m = 0
+            for j in range(k):  # branch-free: a branch per point mispredicts at every contact
+                hits[m] = j
+                m += contact[j]
             sums = np.zeros((2, 6))  # per pad (left: +Y, right: -Y): count, in area, z, normal x, y, z
-            for j in range(k):  # both pads in one pass, each summed in point order
-                left, right = y_hi[j] >= hi - band, y_lo[j] <= lo + band
-                if not (left or right):
-                    continue
+            for t in range(m):  # both pads in one pass, each summed in point order
+                j = hits[t]
+                left, right = y_hi[j] >= left_from, y_lo[j] <= right_to
                 i = idx[j]
                 # the normal in the grasp frame: R^T n
                 nx = r[0, 0] * normals[i, 0] + r[1, 0] * normals[i, 1] + r[2, 0] * normals[i, 2]
