@@ -50,6 +50,8 @@ class MeshEntry:
     volume_m3: float
     """Enclosed volume if the mesh is watertight, else the convex-hull volume (an upper bound)."""
     watertight: bool
+    file_faces: int
+    """Faces as read from the file(s), before merging and cleaning (what a dataset's published count means)."""
 
 
 def load_mesh(path: Path | str, scale: float | tuple[float, float, float] = 1.0) -> MeshEntry:
@@ -72,7 +74,8 @@ def load_mesh(path: Path | str, scale: float | tuple[float, float, float] = 1.0)
 @functools.lru_cache(maxsize=MESH_CACHE_SIZE)
 def _load_mesh_cached(path: Path, _mtime_ns: int, scale: float | tuple[float, float, float]) -> MeshEntry:
     vertices, faces = _read_mesh_file(path)
-    return _validated(trimesh.Trimesh(vertices * np.asarray(scale), faces, process=True), str(path))
+    mesh = trimesh.Trimesh(vertices * np.asarray(scale), faces, process=True)
+    return _validated(mesh, str(path), file_faces=len(faces))
 
 
 def _read_mesh_file(path: Path) -> tuple[np.ndarray, np.ndarray]:
@@ -123,7 +126,7 @@ def _primitive_entry(name: str) -> MeshEntry:
     return _validated(PRIMITIVES[name](), f"primitive {name!r}")
 
 
-def _validated(mesh: trimesh.Trimesh, what: str) -> MeshEntry:
+def _validated(mesh: trimesh.Trimesh, what: str, file_faces: int | None = None) -> MeshEntry:
     if len(mesh.faces) == 0:
         raise ObjectError(f"broken mesh {what}: it has no faces")
     if not np.all(np.isfinite(mesh.vertices)):
@@ -146,7 +149,8 @@ def _validated(mesh: trimesh.Trimesh, what: str) -> MeshEntry:
         )
     mesh.vertices.flags.writeable = False
     mesh.faces.flags.writeable = False
-    return MeshEntry(mesh=mesh, volume_m3=volume, watertight=watertight)
+    n_read = len(mesh.faces) if file_faces is None else file_faces
+    return MeshEntry(mesh=mesh, volume_m3=volume, watertight=watertight, file_faces=n_read)
 
 
 def object_mesh(cfg: Any, name: str) -> tuple[MeshEntry, str]:
@@ -165,7 +169,7 @@ def _object_mesh(cfg: Any, name: str) -> tuple[MeshEntry, ObjectSource]:
     else:
         entry = _assembled(source)
     if source.published_faces is not None:
-        check_published_faces(single.file, source.published_faces)
+        check_published_faces(single.file, entry.file_faces, source.published_faces)
     if source.published_size is not None:
         scale = np.asarray(single.scale, dtype=float)
         check_published_size(

@@ -143,10 +143,9 @@ def check_file(path: Path) -> None:
         check_ply(path, data)
 
 
-def check_published_faces(path: Path, expected: int) -> None:
-    """Raise ObjectError unless the OBJ file ``path`` holds the face count its dataset publishes (a file cut
-    together with its header declares nothing itself)."""
-    n_faces = obj_counts(path.read_bytes())[1]
+def check_published_faces(path: Path, n_faces: int, expected: int) -> None:
+    """Raise ObjectError unless the mesh file ``path``, read with ``n_faces`` faces, holds the face count its
+    dataset publishes (a file cut together with its header declares nothing itself)."""
     if n_faces != expected:
         raise _damaged(path, f"it holds {n_faces} faces, its dataset's models have {expected}")
 
