@@ -1,7 +1,9 @@
-"""Sessions CI and developers call: ``nox -s tests``, ``nox -s lint``, ``nox -s docs``, ``nox -s bench``,
-``nox -s reproduce``, ``nox -s slurm``."""
+"""Sessions CI and developers call: ``nox -s tests``, ``nox -s lint``, ``nox -s docs``, ``nox -s wheel``,
+``nox -s bench``, ``nox -s reproduce``, ``nox -s slurm``."""
 
 import os
+import shutil
+import tempfile
 import time
 from pathlib import Path
 
@@ -42,6 +44,38 @@ def docs(session: nox.Session) -> None:
     start = time.perf_counter()
     session.run("mkdocs", "build", "--strict", *session.posargs, env=env)
     session.log(f"docs: built in {time.perf_counter() - start:.1f} s")
+
+
+@nox.session(reuse_venv=False)
+def wheel(session: nox.Session) -> None:
+    """The installed app, not the checkout: build the wheel, install it (the tested dependency set,
+    ``constraints.txt``, from the pip cache) into a fresh venv, then from an empty temporary folder run a
+    job (the procedural objects, 1 trial each), ``report`` on it and ``plan``. Fails if ``graspexp`` or
+    its YAML (``conf/``, shipped as ``graspexp.conf``) is found anywhere but in the venv."""
+    start = time.perf_counter()
+    dist = Path(session.create_tmp()) / "dist"
+    shutil.rmtree(dist, ignore_errors=True)
+    session.run("python", "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(dist), str(HERE))
+    (built,) = dist.glob("graspexp-*.whl")
+    # from the pip cache; not byte-compiled at install (the job compiles what it imports), which halves the
+    # install's CPU time
+    session.install("-q", "--no-compile", str(built), "-c", str(HERE / "constraints.txt"))
+    installed_s = time.perf_counter() - start
+    with tempfile.TemporaryDirectory(prefix="graspexp-wheel-") as work:
+        session.chdir(work)
+        env = {**ENV, "PYTHONPATH": ""}
+        where = "import graspexp.config.registry as r; print(r.__file__); print(r.CONF_DIR)"
+        found = session.run("python", "-c", where, silent=True, env=env).split()
+        session.log(f"wheel: graspexp from {found[0]}, its YAML from {found[1]}")
+        if any(not path.startswith(session.virtualenv.location) for path in found):
+            session.error(f"wheel: graspexp or its conf/ found outside the venv: {found}")
+        job = ["dataset=primitives", "trials=1", "progress=false", "hydra.run.dir=run"]
+        session.run("graspexp", *job, env=env)
+        session.run("graspexp", "report", "run", env=env)
+        session.run("graspexp", "plan", "dataset=primitives", "objects=[can]", env=env)
+    session.log(
+        f"wheel: built and installed in {installed_s:.1f} s, total {time.perf_counter() - start:.1f} s wall"
+    )
 
 
 @nox.session
