@@ -48,7 +48,8 @@ from omegaconf import OmegaConf
 
 from graspexp.config import ConfigError, PluginError
 from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
-from graspexp.report.collect import RESULTS_CSV, collect
+from graspexp.core.run_layout import results_csv
+from graspexp.report.collect import collect
 from graspexp.report.compare import FC_MU, check_same_drops, render_markdown
 from graspexp.report.compare import success_by_noise as noise_success_table
 from graspexp.report.contact_area import IN_AREA_TOLERANCE_M, finger_contacts_in_area
@@ -243,7 +244,7 @@ def run_all(bench: Benchmark, todo: list[Job]) -> list[str]:
     for planner_jobs in by_planner.values():
         rc = subprocess.call(sweep_command(bench, planner_jobs))
         for job in planner_jobs:
-            if not (Path(job.run_dir) / RESULTS_CSV).is_file():
+            if not results_csv(job.run_dir).is_file():
                 errors.append(f"{job.run_dir}: no results (the sweep of {job.planner} exited {rc})")
     return errors
 
@@ -319,7 +320,7 @@ def ranking(df: pd.DataFrame, dataset: str, settings: list[str]) -> pd.DataFrame
 def reproduce_record(bench: Benchmark, all_jobs: list[Job], configs: list[dict], argv: list[str]) -> dict:
     """Everything needed to re-run the suite: command, benchmark keys, each job's composed config
     (``configs``, in job order), package versions, and each planner's package, entry point and version."""
-    from graspexp.run.runner import package_versions
+    from graspexp.run.provenance import package_versions
 
     planners = {}
     for name in dict.fromkeys(j.planner for j in all_jobs):
