@@ -57,6 +57,7 @@ from graspexp.report.paper import PAPER_TABLES, SETTINGS, TRIALS_PER_SETTING
 from graspexp.report.render import display_frame, footnotes, markdown
 from graspexp.report.stats import percentiles, success_pct
 from graspexp.report.tables import failure_breakdown, success_table
+from graspexp.run.multirun import multirun_command
 from graspexp.run.suites import NOISE_LEVELS, PAPER_MODES, PAPER_ROTS, Job, benchmark_suite
 from graspexp.tools.cli import compose_checked, fail, positive_int, tool_parser
 
@@ -217,21 +218,17 @@ def sweep_command(bench: Benchmark, planner_jobs: list[Job]) -> list[str]:
         launcher += [f"hydra.launcher.partition={bench.slurm_partition}"] if bench.slurm_partition else []
     else:
         launcher = ["hydra/launcher=joblib", f"hydra.launcher.n_jobs={bench.n_jobs}"]
-    return [
-        sys.executable,
-        "-m",
-        "graspexp",
-        "-m",
+    overrides = [
         f"planner={first.planner}",
         f"dataset={','.join(dict.fromkeys(j.dataset for j in planner_jobs))}",
         f"mode={','.join(dict.fromkeys(j.mode for j in planner_jobs))}",
         f"rot={','.join(dict.fromkeys(j.rot for j in planner_jobs))}",
         f"perception.noise={noise}",
         *rest,
-        f"hydra.sweep.dir={Path(bench.out) / first.planner / 'runs'}",
         f"hydra.sweep.subdir='{RUN_SUBDIR}'",  # quoted: Hydra resolves it per job
-        *launcher,
+        *launcher,  # last: the benchmark's launcher keys win over any in the job overrides
     ]
+    return multirun_command(Path(bench.out) / first.planner / "runs", overrides, launcher=())
 
 
 def run_all(bench: Benchmark, todo: list[Job]) -> list[str]:
