@@ -46,6 +46,22 @@ def docs(session: nox.Session) -> None:
     session.log(f"docs: built in {time.perf_counter() - start:.1f} s")
 
 
+WHEEL_SOURCE_SKIPS = {"build", "outputs", "datasets", "docs", "tests", "examples"}
+"""Top-level entries ``nox -s wheel`` leaves out of the copy it builds from (with every top-level dot entry:
+.git, .venv, .nox, caches; and ``__pycache__`` and egg-info anywhere): build outputs, data, runs."""
+
+
+def _wheel_source_skips(folder: str, names: list[str]) -> set[str]:
+    top = Path(folder) == HERE
+    return {
+        n
+        for n in names
+        if (top and (n in WHEEL_SOURCE_SKIPS or n.startswith(".")))
+        or n == "__pycache__"
+        or n.endswith(".egg-info")
+    }
+
+
 @nox.session(reuse_venv=False)
 def wheel(session: nox.Session) -> None:
     """The installed app, not the checkout: build the wheel, install it (the tested dependency set,
@@ -53,9 +69,14 @@ def wheel(session: nox.Session) -> None:
     job (the procedural objects, 1 trial each), ``report`` on it and ``plan``. Fails if ``graspexp`` or
     its YAML (``conf/``, shipped as ``graspexp.conf``) is found anywhere but in the venv."""
     start = time.perf_counter()
-    dist = Path(session.create_tmp()) / "dist"
+    tmp = Path(session.create_tmp())
+    src, dist = tmp / "src", tmp / "dist"
+    shutil.rmtree(src, ignore_errors=True)
     shutil.rmtree(dist, ignore_errors=True)
-    session.run("python", "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(dist), str(HERE))
+    # built from a copy without build outputs: setuptools would package a stale build/lib (a module
+    # removed since the last build) and the checkout's egg-info
+    shutil.copytree(HERE, src, ignore=_wheel_source_skips)
+    session.run("python", "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(dist), str(src))
     (built,) = dist.glob("graspexp-*.whl")
     # from the pip cache; not byte-compiled at install (the job compiles what it imports), which halves the
     # install's CPU time
