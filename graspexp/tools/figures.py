@@ -71,7 +71,7 @@ def _scatter(ax, pts, colour, size=POINT_SIZE, alpha=0.8, **kw):
 
 
 def _split_cloud(ax, det, rest_alpha=0.25):
-    cloud, mask = det["cloud"], det["area_mask"]
+    cloud, mask = det.cloud, det.area_mask
     _scatter(ax, cloud[~mask], REST_COLOUR, alpha=rest_alpha)
     _scatter(ax, cloud[mask], AREA_COLOUR)
 
@@ -79,9 +79,7 @@ def _split_cloud(ax, det, rest_alpha=0.25):
 def _table(ax, det, extent_pts):
     lo, hi = extent_pts[:, :2].min(axis=0), extent_pts[:, :2].max(axis=0)
     xx, yy = np.meshgrid([lo[0], hi[0]], [lo[1], hi[1]])
-    ax.plot_surface(
-        xx, yy, np.full_like(xx, float(det["table_z"])), color="tab:blue", alpha=0.18, linewidth=0
-    )
+    ax.plot_surface(xx, yy, np.full_like(xx, float(det.table_z)), color="tab:blue", alpha=0.18, linewidth=0)
 
 
 def _cluster_colours(k: int):
@@ -91,8 +89,8 @@ def _cluster_colours(k: int):
 
 def _path_lines(ax, det, which, colour, **kw):
     """Draw the (k, p) pairs of ``which`` (a (K, M) bool mask, subsampled) as sphere-point -> centre lines."""
-    r = float(det["sphere_radius"])
-    centers, dirs = det["centers"], det["directions"]
+    r = float(det.sphere_radius)
+    centers, dirs = det.centers, det.directions
     stride = np.zeros(dirs.shape[1], dtype=bool)
     stride[::PATH_STRIDE] = True
     for k, p in zip(*np.nonzero(which & stride), strict=True):
@@ -101,8 +99,8 @@ def _path_lines(ax, det, which, colour, **kw):
 
 
 def _sphere_extent(det) -> np.ndarray:
-    r = float(det["sphere_radius"])
-    return np.vstack([det["cloud"], det["centers"] + r, det["centers"] - r])
+    r = float(det.sphere_radius)
+    return np.vstack([det.cloud, det.centers + r, det.centers - r])
 
 
 def _save(fig, path: Path) -> Path:
@@ -116,8 +114,8 @@ def draw_object(planned: PlannedObject, out: Path) -> list[Path]:
     """Write the seven per-object figures into ``out``; returns their paths."""
     out.mkdir(parents=True, exist_ok=True)
     det, name = planned.result.details, planned.model.name
-    cloud, mask = det["cloud"], det["area_mask"]
-    k = len(det["centers"])
+    cloud, mask = det.cloud, det.area_mask
+    k = len(det.centers)
     colours = _cluster_colours(k)
     written = []
 
@@ -136,32 +134,32 @@ def draw_object(planned: PlannedObject, out: Path) -> list[Path]:
     fig = plt.figure(figsize=FIG_SIZE_IN)
     ax = _axes(fig, title=f"{name}: K = {k} clusters and their centres")
     _scatter(ax, cloud[~mask], "lightgray", alpha=0.3)
-    area, labels = cloud[mask], det["labels"]
+    area, labels = cloud[mask], det.labels
     for j in range(k):
         _scatter(ax, area[labels == j], [colours[j]], size=3.0)
-    ax.scatter(*det["centers"].T, s=60, c=colours, edgecolors="black", linewidths=1.2, depthshade=False)
+    ax.scatter(*det.centers.T, s=60, c=colours, edgecolors="black", linewidths=1.2, depthshade=False)
     _equal_aspect(ax, cloud)
     written.append(_save(fig, out / "fig05_clusters.png"))
 
-    m = det["directions"].shape[1]
+    m = det.directions.shape[1]
     fig = plt.figure(figsize=FIG_SIZE_IN)
     ax = _axes(fig, title=f"{name}: M = {m} paths per cluster (1 in {PATH_STRIDE} drawn)")
     _split_cloud(ax, det)
-    _path_lines(ax, det, np.ones_like(det["feasible"]), lambda j: colours[j])
+    _path_lines(ax, det, np.ones_like(det.feasible), lambda j: colours[j])
     _equal_aspect(ax, _sphere_extent(det))
     written.append(_save(fig, out / "fig06_paths.png"))
 
     fig = plt.figure(figsize=FIG_SIZE_IN)
     ax = _axes(fig, title=f"{name}: main axis of the grasping area (PCA)")
     _split_cloud(ax, det)
-    a, centroid = det["main_axis"], area.mean(axis=0)
+    a, centroid = det.main_axis, area.mean(axis=0)
     proj = (area - centroid) @ a
     ends = centroid + np.outer([proj.min() - 0.02, proj.max() + 0.02], a)
     ax.plot(*ends.T, color="red", lw=3)
     _equal_aspect(ax, cloud)
     written.append(_save(fig, out / "fig07_main_axis.png"))
 
-    feasible = det["feasible"]
+    feasible = det.feasible
     fig = plt.figure(figsize=FIG_SIZE_IN)
     n_removed = int((~feasible).sum())
     ax = _axes(
@@ -186,10 +184,10 @@ def _draw_pose(planned: PlannedObject, path: Path) -> Path:
     )
     _split_cloud(ax, det, rest_alpha=0.15)
     o, R = g.pose[:3, 3], g.pose[:3, :3]
-    length = 0.6 * float(det["sphere_radius"])
+    length = 0.6 * float(det.sphere_radius)
     for col, colour in enumerate(("red", "green", "blue")):
         ax.plot(*np.stack([o, o + length * R[:, col]]).T, color=colour, lw=2.5)
-    start = o - float(det["sphere_radius"]) * R[:, 2]
+    start = o - float(det.sphere_radius) * R[:, 2]
     ax.plot(*np.stack([start, o]).T, color="black", lw=1, ls=":")
     geometry = GripperGeometry.of(gr)
     half_w, root, tip = g.width_m / 2, geometry.root_z_m, geometry.tip_z_m
@@ -199,7 +197,7 @@ def _draw_pose(planned: PlannedObject, path: Path) -> Path:
         ax.plot(*finger.T, color="black", lw=3)
     palm = np.stack([o - half_w * y + root * z, o + half_w * y + root * z])
     ax.plot(*palm.T, color="black", lw=3)
-    _equal_aspect(ax, np.vstack([det["cloud"], start]))
+    _equal_aspect(ax, np.vstack([det.cloud, start]))
     return _save(fig, path)
 
 
@@ -211,7 +209,7 @@ def draw_overview(planned: Sequence[PlannedObject], path: Path, title: str) -> P
     for i, item in enumerate(planned):
         ax = _axes(fig, (rows, cols, i + 1), title=item.model.name)
         _split_cloud(ax, item.result.details, rest_alpha=0.4)
-        _equal_aspect(ax, item.result.details["cloud"])
+        _equal_aspect(ax, item.result.details.cloud)
     fig.suptitle(title, fontsize=11)
     return _save(fig, path)
 
