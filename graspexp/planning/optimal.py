@@ -140,6 +140,32 @@ def paper_candidates(req: PlanRequest, planner: str, cluster_length_m: float | N
     return Candidates(points, mask, axis, pose_axis, clusters, directions, feasible, costs)
 
 
+def paper_details(
+    req: PlanRequest, cand: Candidates, best: tuple[int, int], pose: np.ndarray, width_m: float
+) -> dict:
+    """The fields of :class:`graspexp.planning.details.PaperDetails` for the chosen path ``best`` (k, p)
+    with grasp ``pose`` (4, 4) and opening ``width_m`` (m)."""
+    return {
+        "cloud": cand.points,
+        "area_mask": cand.area_mask,
+        "labels": cand.clusters.labels,
+        "centers": cand.clusters.centers_m,
+        "radii": cand.clusters.radii_m,
+        "main_axis": cand.axis,
+        "pose_axis": cand.pose_axis,
+        "directions": cand.directions,
+        "feasible": cand.feasible,
+        "costs": cand.costs,
+        "best": np.array(best),
+        "pose": pose,
+        "width": width_m,
+        "mode": req.mode,
+        "table_z": float(req.table_z),
+        "sphere_radius": float(req.planner.sphere_radius_m),
+        "gripper_max_width": float(req.gripper.max_width_m),
+    }
+
+
 def pose_axis_source(pl, area_m: np.ndarray) -> str:
     """Which cloud's main axis the grasp frame's X follows: ``object`` or ``area`` (``planner.pose_axis``;
     ``area_if_elongated``: the area's when its :func:`.clusters.elongation` reaches
@@ -186,14 +212,8 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
     """
     cand = paper_candidates(req, req.planner.name)
     pl, gr = req.planner, req.gripper
-    points, mask, clusters = cand.points, cand.area_mask, cand.clusters
-    centers, radii, directions, feasible, costs = (
-        clusters.centers_m,
-        clusters.radii_m,
-        cand.directions,
-        cand.feasible,
-        cand.costs,
-    )
+    centers, radii = cand.clusters.centers_m, cand.clusters.radii_m
+    feasible, costs = cand.feasible, cand.costs  # narrowed in place below: the details' record
     k, m = costs.shape
     openings = opening_widths_m(radii, pl.width_margin, gr)  # (K,) m
     tests = PathTests.empty(k, m)
@@ -235,26 +255,10 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
         },
     )
     details = OptimalDetails(
-        cloud=points,
-        area_mask=mask,
-        labels=clusters.labels,
-        centers=centers,
-        radii=radii,
-        main_axis=cand.axis,
-        pose_axis=cand.pose_axis,
-        directions=directions,
-        feasible=feasible,
-        costs=costs,
+        **paper_details(req, cand, (kb, pb), pose, width),
         section_width=section,
         section_span=spans,
         contact_share=tests.share,
-        best=np.array([kb, pb]),
-        pose=pose,
-        width=width,
-        mode=req.mode,
-        table_z=float(req.table_z),
-        sphere_radius=float(pl.sphere_radius_m),
-        gripper_max_width=float(gr.max_width_m),
     )
     return PlanResult(grasp=grasp, details=details)
 

@@ -62,7 +62,7 @@ from graspexp.planning.collision import Placement, cloud_hits, place_for_request
 from graspexp.planning.details import Candidate, OptimalPlusDetails, Shortlist
 from graspexp.planning.friction import cone_cosine
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
-from graspexp.planning.optimal import paper_candidates
+from graspexp.planning.optimal import paper_candidates, paper_details
 from graspexp.planning.pose import grasp_rotations, opening_widths_m
 from graspexp.planning.request import PlanRequest, PlanResult
 from graspexp.planning.stability import (
@@ -163,24 +163,8 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
         },
     )
     details = OptimalPlusDetails(
-        cloud=points,
-        area_mask=cand.area_mask,
-        labels=cand.clusters.labels,
-        centers=cand.clusters.centers_m,
-        radii=cand.clusters.radii_m,
-        main_axis=cand.axis,
-        pose_axis=cand.pose_axis,
-        directions=cand.directions,
-        costs=cand.costs,
-        feasible=cand.feasible,
+        **paper_details(req, cand, (kb, pb), pose, width),
         com=com,
-        best=np.array([kb, pb]),
-        pose=pose,
-        width=width,
-        mode=req.mode,
-        table_z=float(req.table_z),
-        sphere_radius=float(pl.sphere_radius_m),
-        gripper_max_width=float(gr.max_width_m),
         shortlist=Shortlist(
             poses=poses,
             widths=widths,
