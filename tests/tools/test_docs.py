@@ -16,8 +16,8 @@ import pytest
 import graspexp
 from graspexp.config.job import JobConfig
 from graspexp.config.plugins import LoadedPlanner, load_planners
+from graspexp.config.reference import render
 from graspexp.config.registry import SCHEMAS, group_options
-from graspexp.tools.config_reference import render
 
 ROOT = Path(graspexp.__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
