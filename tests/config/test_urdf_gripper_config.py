@@ -4,7 +4,8 @@ one line naming the key and the file."""
 import re
 
 import pytest
-from conftest import compose_cfg, write_urdf_gripper
+from helpers.config import compose_cfg
+from helpers.objects import write_urdf_gripper
 
 from graspexp.config import ConfigError, validate
 from graspexp.config.compose import compose_validated

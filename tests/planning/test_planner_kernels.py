@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 import pytest
-from test_planner_common import RG2, UPRIGHT_SUPPORT_Z, upright_request
+from helpers.planning import RG2, UPRIGHT_SUPPORT_Z, upright_request
 
 import graspexp.planning.optimal as optimal
 from graspexp.config import CostConfig, DatasetConfig, OptimalConfig

@@ -4,9 +4,9 @@ import dataclasses
 
 import numpy as np
 import pytest
+from helpers.planning import PAPER_STEPS_ONLY, RG2, box_cloud, cylinder_cloud, request
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from test_planner_common import PAPER_STEPS_ONLY, RG2, box_cloud, cylinder_cloud, request
 
 from graspexp.config import OptimalConfig
 from graspexp.core.geometry import quat_wxyz_to_matrix

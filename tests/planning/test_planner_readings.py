@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
-from conftest import compose_cfg
+from helpers.config import compose_cfg
+from helpers.planning import PAPER_STEPS_ONLY, RG2, cylinder_cloud, request
 from omegaconf import OmegaConf
-from test_planner_common import PAPER_STEPS_ONLY, RG2, cylinder_cloud, request
 
 from graspexp.config import OptimalConfig
 from graspexp.planning import plan_optimal

@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 import pytest
-from test_planner_common import PAPER_STEPS_ONLY, RG2, UPRIGHT_SUPPORT_Z, upright_request
+from helpers.planning import PAPER_STEPS_ONLY, RG2, UPRIGHT_SUPPORT_Z, upright_request
 
 from graspexp.config import DatasetConfig, OptimalConfig
 from graspexp.config.compose import compose_config

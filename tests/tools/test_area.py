@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import trimesh
 import yaml
-from conftest import compose_cfg, shared_data_root
+from helpers.config import compose_cfg, shared_data_root
 
 from graspexp.datasets import ObjectModel, job_object
 from graspexp.datasets.folder import read_sidecar
