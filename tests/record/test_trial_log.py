@@ -6,14 +6,15 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import compose_cfg, strictly_valid
+from helpers.config import compose_cfg
+from helpers.logs import strictly_valid
 from mcap.reader import make_reader
 
 from graspexp.record import TrialRecorder, read_trial
 from graspexp.run.objects import load_object, trial_context
 from graspexp.sim.trial import plain_config, run_trial
 
-pytestmark = [pytest.mark.sim, pytest.mark.slow]
+pytestmark = pytest.mark.slow
 REPO = Path(__file__).resolve().parents[2]
 WALL_CLOCK_KEYS = {"timings_s"}
 """Result fields that hold wall-clock time: the only payload bytes allowed to differ between two runs."""

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
-from conftest import compose_cfg, foreign_log
+from helpers.config import compose_cfg
+from helpers.logs import foreign_log
 from omegaconf import OmegaConf
 from omegaconf.errors import ReadonlyConfigError
 
