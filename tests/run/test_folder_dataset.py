@@ -2,13 +2,10 @@
 an object that cannot be used fails alone, one whose mesh cannot be repaired falls back to a convex
 decomposition (real SAPIEN physics)."""
 
-import subprocess
-import sys
-from pathlib import Path
-
 import numpy as np
 import pandas as pd
 import trimesh
+from helpers.cli import graspexp
 from helpers.config import REPO
 from helpers.objects import make_object_folder
 
@@ -17,18 +14,12 @@ from graspexp.record.reader import read_metadata
 NAMES = ["arc", "ball", "box", "bracket", "can", "cone"]
 
 
-def graspexp(*args: str, cwd: Path) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "graspexp", *args], cwd=cwd, capture_output=True, text=True, timeout=900
-    )
-
-
 def test_a_folder_runs_every_setting_with_three_planners_and_reports(tmp_path):
     objects = make_object_folder(tmp_path / "objects")
     out = tmp_path / "bench"
     bench = graspexp(
         "benchmark", "planner=optimal_plus", "dataset=folder", f"dataset.root={objects}", "trials=1",
-        "--noise", "", "--compare", "optimal,antipodal", "--out", str(out), "progress=false", cwd=REPO,
+        "--noise", "", "--compare", "optimal,antipodal", "--out", str(out), "progress=false", cwd=REPO, timeout=900,
     )  # fmt: skip
     assert bench.returncode == 0, bench.stderr[-3000:]
     summary = (out / "optimal_plus" / "summary.md").read_text()
