@@ -6,14 +6,13 @@ success of each job's results.csv, its resume, a job that cannot run (a FAIL tri
 and the held-out scoring with its report.
 """
 
-import os
 import subprocess
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
 import yaml
+from helpers.cli import graspexp
 
 from graspexp.config.compose import expand_sweeps
 from graspexp.config.job import OBJECTIVES
@@ -34,9 +33,7 @@ STUDY = [
 
 
 def _graspexp(*args: str, ok: bool = True) -> subprocess.CompletedProcess:
-    env = {**os.environ, "OMP_NUM_THREADS": "1"}
-    cmd = [sys.executable, "-m", "graspexp", *args]
-    proc = subprocess.run(cmd, cwd=REPO, env=env, capture_output=True, text=True, timeout=180)
+    proc = graspexp(*args, timeout=180)
     if ok:
         assert proc.returncode == 0, proc.stderr[-3000:]
     return proc
