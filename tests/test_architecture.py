@@ -1,5 +1,5 @@
 """The package's import graph: no cycle (type-level imports included), stages import one way
-(config -> datasets -> planning -> sim -> record -> report -> run), the tools sit above every stage, and
+(config -> datasets -> perception -> planning -> sim -> record -> report -> run), the tools sit above every stage, and
 the package's top level holds only stage packages, the base package and the entry point."""
 
 import ast
@@ -11,7 +11,7 @@ import graspexp
 
 PACKAGE = Path(graspexp.__file__).parent
 
-STAGES = ("config", "datasets", "planning", "sim", "record", "report", "run")
+STAGES = ("config", "datasets", "perception", "planning", "sim", "record", "report", "run")
 """The stages in import order: a module of one stage imports only from its own stage or an earlier one."""
 STAGE_OF_PACKAGE = {**{s: s for s in STAGES}, "quality": "planning"}
 """Packages that belong to a stage without carrying its name (grasp quality is a planning-side check)."""
@@ -84,7 +84,7 @@ def test_stages_import_one_way():
                 if STAGES.index(dep_kind[6:]) > STAGES.index(kind[6:]):
                     wrong.append(f"{module} ({kind}) imports {dep} ({dep_kind})")
     assert not wrong, (
-        "imports against config -> datasets -> planning -> sim -> record -> report -> run:\n"
+        "imports against config -> datasets -> perception -> planning -> sim -> record -> report -> run:\n"
         + "\n".join(sorted(wrong))
     )
 
