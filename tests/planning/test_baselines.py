@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import trimesh
 from omegaconf import OmegaConf
-from test_planner_common import RG2  # explicit RG2 dimensions, independent of conf/gripper
+from test_planner_common import RG2, full_view  # explicit RG2 dimensions, independent of conf/gripper
 
 from graspexp.config.compose import compose_config
 from graspexp.config.gripper import GripperGeometry
@@ -34,7 +34,19 @@ def _cloud(mesh: trimesh.Trimesh, n: int = 768, seed: int = 0) -> tuple[np.ndarr
 def _request(planner: str, pts, normals, mode: str = "bin", seed: int = 3, area=None) -> PlanRequest:
     cfg = _cfg(planner, mode)
     mask = np.ones(len(pts), bool) if area is None else area
-    return PlanRequest(pts, normals, mask, np.eye(4), TABLE_Z, mode, cfg.gripper, cfg.planner, cfg.cost, seed)
+    return PlanRequest(
+        pts,
+        normals,
+        mask,
+        np.eye(4),
+        TABLE_Z,
+        mode,
+        cfg.gripper,
+        cfg.planner,
+        cfg.cost,
+        seed,
+        observation=full_view(pts, normals),
+    )
 
 
 def _shapes() -> dict[str, trimesh.Trimesh]:
@@ -106,6 +118,7 @@ def test_contract_on_a_primitive(name: str) -> None:
         cfg.planner,
         cfg.cost,
         11,
+        observation=full_view(pts + pose[:3, 3], model.normals @ pose[:3, :3].T),
     )
     _check_contract(req, name)
 

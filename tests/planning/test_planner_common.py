@@ -3,6 +3,7 @@
 import numpy as np
 
 from graspexp.config import CostConfig, GripperConfig, OptimalConfig
+from graspexp.perception import Observation
 from graspexp.planning import PlanRequest
 
 RG2 = GripperConfig(
@@ -96,3 +97,15 @@ def test_synthetic_clouds_lie_on_their_surfaces():
     on_face = np.isclose(np.abs(box[:, 0]), 0.01) | np.isclose(np.abs(box[:, 1]), 0.02)
     on_face |= np.isclose(box[:, 2], 0.0) | np.isclose(box[:, 2], 0.06)
     assert on_face.all()
+
+
+def full_view(points: np.ndarray, normals: np.ndarray) -> Observation:
+    """An observation in which the camera saw the whole cloud (no views, every point the target, id 1):
+    lets the planners that read ``PlanRequest.observation`` take part in the contract tests."""
+    return Observation(
+        views=(),
+        points=np.asarray(points, dtype=float),
+        normals=np.asarray(normals, dtype=float),
+        point_ids=np.ones(len(points), dtype=np.int32),
+        target_id=1,
+    )

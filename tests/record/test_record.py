@@ -334,6 +334,11 @@ def test_result_schema_pinned():
         "sim_time_s",
         "steps",
         "at_rest",
+        "pose_trans_err_mm",
+        "pose_rot_err_deg",
+        "pose_adds_mm",
+        "registration_fitness",
+        "registration_cpu_s",
     ]
 
 
