@@ -23,8 +23,14 @@ def test_the_d435_preset_and_truth_default():
     [
         ("perception.source=stereo", "perception.source='stereo' is invalid: expected one of truth, depth"),
         ("perception.registration.prior=pvn3d", "perception.registration.prior='pvn3d' is invalid"),
-        ("perception.camera.elevation_deg=0", "perception.camera.elevation_deg=0.0 is invalid: expected a number in (0, 90] deg"),
-        ("perception.camera.min_range_m=5", "perception.camera.min_range_m=5.0 is invalid: expected < perception.camera.max_range_m=3.0"),
+        (
+            "perception.camera.elevation_deg=0",
+            "perception.camera.elevation_deg=0.0 is invalid: expected a number in (0, 90] deg",
+        ),
+        (
+            "perception.camera.min_range_m=5",
+            "perception.camera.min_range_m=5.0 is invalid: expected < perception.camera.max_range_m=3.0",
+        ),
     ],
 )
 def test_bad_values_name_the_key(override, message):
