@@ -9,6 +9,7 @@ import pytest
 import yaml
 
 from graspexp.config.job import JobConfig
+from graspexp.config.perception import CameraConfig
 from graspexp.config.plugins import get_plugin
 from graspexp.config.registry import CONF_DIR, SCHEMAS
 
@@ -30,7 +31,7 @@ def _schema(path: Path, data: dict) -> type:
         return JobConfig
     if name.startswith("schema_planner_"):
         return get_plugin(name.removeprefix("schema_planner_")).plugin.config
-    return SCHEMAS[name.removeprefix("schema_")]
+    return {**SCHEMAS, "camera": CameraConfig}[name.removeprefix("schema_")]
 
 
 def _default(field: dataclasses.Field) -> object:

@@ -6,8 +6,8 @@ import pytest
 import trimesh
 from helpers.config import compose_cfg
 from helpers.objects import write_urdf_gripper
+from helpers.planning import full_view
 from omegaconf import OmegaConf
-from test_planner_common import full_view
 
 from graspexp.config.plugins import LoadedPlanner, load_planners
 from graspexp.grippers import GripperGeometry
