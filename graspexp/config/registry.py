@@ -25,9 +25,22 @@ SCHEMAS = {
     "sim": SimConfig,
 }
 """The schema of each group with one schema; the ``planner`` group has one per planner (its plugin's)."""
+NESTED_SCHEMAS = {"camera": CameraConfig}
+"""Schemas of the groups nested under a key (``perception/camera``, its options at ``perception.camera``),
+stored as ``schema_<name>``."""
 
-CONF_DIR = str(Path(__file__).resolve().parent.parent / "conf")
-"""The YAML config tree shipped inside the package (``graspexp/conf/<group>/<option>.yaml``)."""
+
+def _conf_dir() -> Path:
+    """The YAML tree: ``graspexp/conf`` in an installed wheel (the package ``graspexp.conf``), else the
+    checkout's top-level ``conf/`` (a source tree or an editable install)."""
+    package = Path(__file__).resolve().parent.parent
+    installed = package / "conf"
+    return installed if (installed / "config.yaml").is_file() else package.parent / "conf"
+
+
+CONF_DIR = str(_conf_dir())
+"""The YAML config tree, ``conf/<group>/<option>.yaml``: the repository's top-level ``conf/``, which the
+wheel ships as ``graspexp/conf`` (``setup.py``)."""
 
 
 def _yaml_options(group: str) -> set[str]:
@@ -60,7 +73,8 @@ def register_configs() -> None:
     cs.store(name=schema_name("job"), node=JobConfig)
     for group, schema in SCHEMAS.items():
         cs.store(name=schema_name(group), node=schema)
-    cs.store(name=schema_name("camera"), node=CameraConfig)  # the group perception/camera
+    for name, schema in NESTED_SCHEMAS.items():
+        cs.store(name=schema_name(name), node=schema)
     presets = _yaml_options("planner")
     for name, found in load_planners().items():
         if isinstance(found, LoadedPlanner):

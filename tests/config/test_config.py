@@ -6,7 +6,8 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import compose_cfg, write_urdf_gripper
+from helpers.config import compose_cfg
+from helpers.objects import write_urdf_gripper
 from omegaconf import OmegaConf
 
 from graspexp.config import AntipodalConfig, ConfigError, JobConfig, OptimalConfig, sim, validate
