@@ -17,7 +17,7 @@ from pathlib import Path
 from graspexp.tools.cli import tool_parser
 
 IGNORED_PREFIXES = ("timings_s", "registration_cpu_s")
-"""Columns that measure wall time: they differ between runs of the same config."""
+"""Columns that measure time (wall, or CPU): they differ between runs of the same config."""
 
 
 def _rows(path: Path) -> dict[tuple[str, str], dict[str, str]]:
