@@ -15,6 +15,7 @@ RESULT_NEUTRAL_KEYS = (
     "dataset.objects",
     "dataset.split",  # which objects run
     "objective",  # what the job returns to a sweeper, computed from the results
+    "dataset.max_faces",  # which objects may run (a larger one is refused), not what a trial gives
     "sim.cache_dir",  # where collision shapes are cached; entries are keyed by mesh content
     "sim.prepare_workers",  # how many processes build the collision shapes, not what they build
     "live",  # whether trials also stream to the Foxglove app

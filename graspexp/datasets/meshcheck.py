@@ -143,6 +143,35 @@ def check_file(path: Path) -> None:
         check_ply(path, data)
 
 
+def declared_faces(path: Path) -> int | None:
+    """The face count a mesh file declares or holds, read without parsing it (OBJ: its ``f`` lines; PLY: the
+    header's ``element face``; binary STL: its count field); None for other formats or an unreadable file."""
+    suffix = path.suffix.lower()
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read() if suffix == ".obj" else fh.read(1 << 16)
+    except OSError:
+        return None  # the loader names the problem
+    if suffix == ".obj":
+        return data.count(b"\nf ") + data.startswith(b"f ")
+    if suffix == ".ply":
+        words = data[: max(data.find(b"end_header"), 0)].decode("ascii", "replace").split()
+        counts = [words[i + 2] for i in range(len(words) - 2) if words[i : i + 2] == ["element", "face"]]
+        return int(counts[0]) if counts and counts[0].isdigit() else None
+    if suffix == ".stl" and data[:5].lower() != b"solid" and len(data) >= 84:
+        return int(np.frombuffer(data, "<u4", 1, 80)[0])
+    return None
+
+
+def check_face_count(what: str, n_faces: int, max_faces: int) -> None:
+    """Raise ObjectError if a mesh of ``n_faces`` exceeds the cap ``dataset.max_faces``."""
+    if n_faces > max_faces:
+        raise ObjectError(
+            f"mesh {what} has {n_faces:,} faces, more than dataset.max_faces={max_faces:,}: decimate it first "
+            "(e.g. MeshLab's Quadric Edge Collapse Decimation) or raise dataset.max_faces"
+        )
+
+
 def check_published_faces(path: Path, n_faces: int, expected: int) -> None:
     """Raise ObjectError unless the mesh file ``path``, read with ``n_faces`` faces, holds the face count its
     dataset publishes (a file cut together with its header declares nothing itself)."""

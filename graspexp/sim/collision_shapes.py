@@ -265,6 +265,11 @@ def _closed_mesh(mesh: trimesh.Trimesh, params: dict) -> tuple[np.ndarray, np.nd
     from graspexp.sim.collision_accuracy import signed_distance_m
 
     kept = [c for c in mesh.split(only_watertight=False) if c.area >= params["min_part_area"] * mesh.area]
+    if not kept:  # a triangle soup: every connected part is as small as scan debris
+        raise RepairError(
+            f"no connected part of the mesh holds {params['min_part_area']:g} of its area (sim.mesh_min_part_area): "
+            "its faces share no edges (a triangle soup?); use sim.collision_method=coacd for this object"
+        )
     area = sum(c.area for c in kept)
     mesh_pts, _ = trimesh.sample.sample_surface(mesh, 2000, seed=0)
     budget = params["max_faces"]

@@ -113,3 +113,10 @@ def test_a_meshlab_area_error_fails_its_object_alone(tmp_path, ply, match):
     _folder(root, **{"box.yaml": f"area:\n  meshlab_ply: {ply}\n"})
     with pytest.raises(ObjectError, match=match):
         _load(root)
+
+
+def test_a_mesh_above_the_face_cap_fails_alone_before_it_is_read(tmp_path):
+    root = _folder(tmp_path)  # a 12-face box under a cap of 10 (a 2.6M-face scan under the default)
+    cfg = compose_cfg("dataset=folder", f"dataset.root={root}", "dataset.max_faces=10").dataset
+    with pytest.raises(ObjectError, match=r"has 12 faces, more than dataset.max_faces=10: decimate it first"):
+        load_object(cfg, "box", 200, 0)
