@@ -178,10 +178,9 @@ def _object_mesh(cfg: Any, name: str) -> tuple[MeshEntry, ObjectSource]:
     if source.published_faces is not None:
         check_published_faces(single.file, entry.file_faces, source.published_faces)
     if source.published_size is not None:
-        scale = np.asarray(single.scale, dtype=float)
         check_published_size(
             Path(source.source),
-            entry.mesh.extents / scale,
+            entry.mesh.extents * 1e3,  # m -> mm
             np.asarray(source.published_size),
             source.published_where,
         )
