@@ -1,5 +1,6 @@
 """Report tier: paper data, Wilson intervals, and the report built from hand-made MCAP logs (no simulator)."""
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -110,7 +111,8 @@ def sweep_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_collect_reads_every_log(sweep_dir: Path) -> None:
     col = collect(sweep_dir)
-    assert len(col.results) == sum(len(v) for v in CELLS.values()) == 40
+    assert len(col.results) + len(col.not_run) == sum(len(v) for v in CELLS.values()) == 40
+    assert set(col.not_run["reason"]) == {"error"} and len(col.not_run) == 2  # never scored
     assert col.unreadable == [] and col.duplicates == []
 
 
@@ -133,8 +135,9 @@ def test_table1_exact_percentages_intervals_and_deltas(sweep_dir: Path) -> None:
     assert (mug["top_reason"], mug["top_reason_n"]) == ("", 0)
     xyz = _cell(t1, "Cleanser B.", "collab", "xyz")
     assert (xyz["top_reason"], xyz["top_reason_n"]) == ("dropped", 5)
+    assert xyz["n"] == 8  # the two trials that ended in an error were not run: no failures of the grasp
     assert (xyz["ours_pct"], xyz["lo_pct"], xyz["hi_pct"], xyz["paper_pct"]) == pytest.approx(
-        (0, 0, 27.8, 90), abs=0.05
+        (0, 0, 32.4, 90), abs=0.05
     )
     # objects without logs stay in the table as n/a, with the paper's value
     meat = _cell(t1, "Meat Can", "collab", "z")
@@ -334,9 +337,9 @@ def test_agreement_flags_cells_below_the_paper_with_their_failure_reason(sweep_d
     bleach_z = cells.loc[("Cleanser B.", "collab", "z")]
     assert (bleach_z["ours_k"], bleach_z["ours_n"], bleach_z["paper_k"]) == (9, 10, 10)
     assert bleach_z["p_below"] == pytest.approx(0.5) and not bleach_z["flagged"]
-    bleach_xyz = cells.loc[("Cleanser B.", "collab", "xyz")]  # 0/10 against the paper's 9/10
+    bleach_xyz = cells.loc[("Cleanser B.", "collab", "xyz")]  # 0/8 run (2 not run) against the paper's 9/10
     assert bleach_xyz["flagged"] and bleach_xyz["top_reason"] == "dropped"
-    assert bleach_xyz["p_below"] == pytest.approx(p_below(0, 10, 9))
+    assert bleach_xyz["p_below"] == pytest.approx(p_below(0, 8, 9))
     ape = ag["linemod"].objects.set_index("label").loc["Ape"]  # 5/10 against 9/10: p = 0.07
     assert ape["p_below"] == pytest.approx(p_below(5, 10, 9)) and not ape["flagged"]
     # One pooled row per setting: every trial of the paper objects we ran against their printed rates.
@@ -405,6 +408,7 @@ def test_collect_reads_results_csv_only_where_a_run_has_no_logs(sweep_dir: Path,
                 "rot": "z",
                 "object": "025_mug",
                 "trial": t,
+                "seed": t,
             }
             | {"success": t % 2 == 0, "reason": "" if t % 2 == 0 else "dropped", "timings_s": "{'plan': 0.5}"}
             for t in range(4)
@@ -416,3 +420,26 @@ def test_collect_reads_results_csv_only_where_a_run_has_no_logs(sweep_dir: Path,
     assert list(rows["success"]) == [True, False, True, False]
     assert set(rows["trans_mm"]) == {10.0} and set(rows["plan_ms"]) == {500.0}
     assert set(col.results.loc[col.results["path"] != "", "trans_mm"]) == {0.0}
+
+
+@pytest.mark.parametrize(
+    "field, value, match",
+    [
+        ("success", "yes", r"row 3: success='yes' is not <class 'bool'>"),
+        ("trial", str(10**30), r"row 3: trial='1000000000000000000000000000000' is not <class 'int'>"),
+        ("reason", "exploded", r"row 3: result field reason='exploded' is not a failure reason"),
+        ("timings_s", "*a", r"row 3: timings_s='\*a' is not"),
+    ],
+)
+def test_a_bad_results_csv_is_unreadable_in_one_line_never_a_traceback(tmp_path, field, value, match):
+    rows = [
+        {"dataset": "ycb", "object": "025_mug", "mode": "bin", "rot": "z", "planner": "optimal", "trial": t,
+         "seed": t, "success": False, "reason": "dropped", "timings_s": "{'plan': 0.5}"}
+        for t in range(2)
+    ]  # fmt: skip
+    rows[1][field] = value
+    pd.DataFrame(rows).to_csv(tmp_path / "results.csv", index=False)
+    col = collect(tmp_path)
+    assert col.results.empty and len(col.unreadable) == 1
+    ((path, why),) = col.unreadable
+    assert path == tmp_path / "results.csv" and re.search(match, why) and "\n" not in why
