@@ -19,8 +19,9 @@ import pandas as pd
 
 from graspexp.config.differences import result_config
 from graspexp.core.outcome import FailureReason, TrialResult, result_from_dict
+from graspexp.core.run_layout import TRIALS_DIR, hydra_dir, results_tables, trials_dir
 from graspexp.core.userinput import load_user_yaml, read_user_yaml, shown
-from graspexp.record import TRIALS_DIR, CorruptLogError, read_result
+from graspexp.record import CorruptLogError, read_result
 from graspexp.record.reader import read_metadata
 from graspexp.record.writer import PARTIAL_SUFFIX
 
@@ -30,7 +31,6 @@ NOISE_KEYS: tuple[str, ...] = ("trans_mm", "rot_deg")
 """The pose-noise level of a trial's run (``perception.noise``): mm and degrees."""
 TRIAL_KEYS: tuple[str, ...] = (*SETTING_KEYS, *NOISE_KEYS, "object", "trial")
 """One trial is identified by these fields."""
-RESULTS_CSV = "results.csv"
 FINGERPRINT_COLUMN = "machine"
 """Column of :func:`collect`: where a log was made (:func:`fingerprint`); empty for results.csv rows."""
 FINGERPRINT_KEYS = (
@@ -123,11 +123,11 @@ def _csv_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
     """Rows of every results.csv below ``root`` whose run directory holds no trial log, each checked as
     strictly as a log's /result (:func:`csv_result`); a table with a bad row is unreadable as a whole."""
     rows, unreadable = [], []
-    for table in sorted(root.rglob(RESULTS_CSV)):
+    for table in results_tables(root):
         run_dir = table.parent
-        if (run_dir / TRIALS_DIR).is_dir() and find_trial_logs(run_dir):
+        if trials_dir(run_dir).is_dir() and find_trial_logs(run_dir):
             continue
-        hydra_cfg = run_dir / ".hydra" / "config.yaml"
+        hydra_cfg = hydra_dir(run_dir) / "config.yaml"
         try:
             config = read_user_yaml(hydra_cfg) if hydra_cfg.is_file() else None
             noise = noise_of(config if isinstance(config, dict) else None)

@@ -40,6 +40,9 @@ def box_cloud(rng: np.random.Generator, n: int, size_m: tuple[float, float, floa
 PAPER_STEPS_ONLY = {"swept_check": False, "min_contacts_in_area": 0.0}
 """``OptimalConfig`` keys that switch off the checks the paper does not print (swept gripper, area rule),
 for tests of the paper's own steps."""
+IN_AREA = {"pose_axis": "object", "min_contacts_in_area": 1.0}
+"""``OptimalConfig`` keys of the preset ``optimal_in_area`` (every pad contact in the grasping area), for
+tests of the area rule (the schema's defaults are the paper preset ``optimal``'s, without it)."""
 
 
 def upright_request(model, pose: np.ndarray, mode: str, planner: OptimalConfig) -> PlanRequest:

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from test_planner_common import PAPER_STEPS_ONLY, RG2, box_cloud, cylinder_cloud, request
+from test_planner_common import IN_AREA, PAPER_STEPS_ONLY, RG2, box_cloud, cylinder_cloud, request
 
 from graspexp.config import OptimalConfig
 from graspexp.core.geometry import quat_wxyz_to_matrix
@@ -293,7 +293,7 @@ def test_property_valid_grasp_for_random_clouds_and_poses(
     )
     res = plan_optimal(req)
     _check_result(res, req)
-    checked = dataclasses.replace(req, planner=OptimalConfig(name="optimal", m=64))
+    checked = dataclasses.replace(req, planner=OptimalConfig(name="optimal", m=64, **IN_AREA))
     try:
         res = plan_optimal(checked)
     except NoFeasibleGrasp as e:
