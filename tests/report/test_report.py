@@ -443,3 +443,20 @@ def test_a_bad_results_csv_is_unreadable_in_one_line_never_a_traceback(tmp_path,
     assert col.results.empty and len(col.unreadable) == 1
     ((path, why),) = col.unreadable
     assert path == tmp_path / "results.csv" and re.search(match, why) and "\n" not in why
+
+
+@pytest.mark.parametrize(
+    "metas, mode, match",
+    [  # one cache key, two shapes (a rewritten shared cache entry), in two settings of one report
+        ([{"collision_key": "k", "collision_sha256": s} for s in ("a" * 64, "b" * 64)], ("z", "xyz"), "two collision shapes"),
+        ([{"area_sha256": s} for s in ("a" * 64, "b" * 64)], ("z", "z"), "two grasping areas"),
+    ],
+)  # fmt: skip
+def test_a_report_never_merges_two_collision_shapes_or_areas(tmp_path, capsys, metas, mode, match) -> None:
+    for i, (meta, rot) in enumerate(zip(metas, mode, strict=True)):
+        path = tmp_path / f"run{i}" / "trials" / "025_mug" / f"{i:03d}.mcap"
+        with TrialRecorder(path, {"config_yaml": "{}", **meta}) as rec:
+            rec.result(0.0, _result("ycb", "025_mug", "collab", rot, i, None, 0.05))
+    assert report_main([str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"graspexp report: error: trials of 025_mug used {match}") and "\n" not in err
