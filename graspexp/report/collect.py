@@ -210,9 +210,16 @@ def collect(root: Path | str) -> Collected:
         check_one_config_per_cell(df)
         check_one_shape_per_object(df)
         df = df.drop(columns=[CONFIG_COLUMN, SHAPES_COLUMN], errors="ignore")
-        error = df["reason"].eq(FailureReason.ERROR.value)
-        not_run, df = df[error].reset_index(drop=True), df[~error].reset_index(drop=True)
+        scored = ran(df)
+        not_run, df = df.drop(scored.index).reset_index(drop=True), scored.reset_index(drop=True)
     return Collected(root=root, results=df, unreadable=unreadable, duplicates=duplicates, not_run=not_run)
+
+
+def ran(df: pd.DataFrame) -> pd.DataFrame:
+    """The trials of a results table that ran to an outcome: all but those that ended in ``error`` (an
+    object that could not be used, a trial that raised), which are never scored (no rate, average, paper
+    table or objective counts them)."""
+    return df[df["reason"] != FailureReason.ERROR.value]
 
 
 def fingerprint(meta: dict[str, str]) -> str:

@@ -8,6 +8,7 @@ import pandas as pd
 from graspexp.core.files import write_atomic
 from graspexp.core.outcome import FailureReason, TrialResult
 from graspexp.core.run_layout import check_not_linked, results_csv, summary_md
+from graspexp.report.collect import ran
 from graspexp.run.locks import RunError
 from graspexp.run.objects import LoadedObject
 
@@ -17,12 +18,6 @@ OBJECTIVES = {"success": pd.Series.mean, "worst_object": pd.Series.min}
 
 NOT_RUN = "not run"
 """How the summary shows the success rate of an object none of whose trials ran to an outcome."""
-
-
-def ran(df: pd.DataFrame) -> pd.DataFrame:
-    """The trials of a results table that ran to an outcome: all but those that ended in ``error`` (an
-    object that could not be used, a trial that raised), which are never scored."""
-    return df[df["reason"] != FailureReason.ERROR.value]
 
 
 def summarize(df: pd.DataFrame) -> pd.DataFrame:

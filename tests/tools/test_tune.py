@@ -188,3 +188,13 @@ def test_a_study_resumed_on_another_data_root_is_refused(tmp_path: Path) -> None
     (line,) = [ln for ln in proc.stderr.splitlines() if ln.startswith("graspexp: error:")]
     assert "holds a study made on other inputs (data_root: /elsewhere in the study" in line
     assert not list(out.glob("*/results.csv"))
+
+
+def test_an_unrun_object_is_not_a_failure_in_the_tuning_report() -> None:
+    from graspexp.report.tuning import _rate, paired_test
+
+    rows = [("ape", 0, False, "error"), ("can", 0, True, None), ("can", 1, False, "dropped")]
+    df = pd.DataFrame(rows, columns=["object", "trial", "success", "reason"])
+    assert _rate(df[df["object"] == "ape"]) == "not run"
+    assert _rate(df).endswith("(1/2)")
+    assert paired_test(df, df.assign(success=True)) == (0, 1, 1.0)
