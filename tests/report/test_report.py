@@ -460,3 +460,17 @@ def test_a_report_never_merges_two_collision_shapes_or_areas(tmp_path, capsys, m
     assert report_main([str(tmp_path)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"graspexp report: error: trials of 025_mug used {match}") and "\n" not in err
+
+
+def test_a_trial_that_never_came_to_rest_is_its_own_failure_class(tmp_path: Path) -> None:
+    """Logs from before ``not_at_rest`` existed planned on the moving object and may say success: the
+    report counts them as ``not_at_rest``, never as a success or a grasp failure."""
+    for i, reason in enumerate((None, "no_contact", None)):
+        result = _result("ycb", "025_mug", "collab", "z", i, reason, 0.05) | {"at_rest": i == 2}
+        with TrialRecorder(
+            tmp_path / "run" / "trials" / "025_mug" / f"{i:03d}.mcap", {"config_yaml": "{}"}
+        ) as rec:
+            rec.result(0.0, result)
+    report = build_report(tmp_path)
+    row = report.failures.set_index(["dataset", "mode", "rot"]).loc[("ycb", "collab", "z")]
+    assert (row["trials"], row["success"], row["not_at_rest"], row["no_contact"]) == (3, 1, 2, 0)

@@ -94,3 +94,17 @@ def test_resume_refuses_logs_of_another_collision_shape_or_area(tmp_path, logged
         check_same_meshes(tmp_path, now)
     _log(tmp_path)  # a log that records neither (older graspexp) is not compared
     check_same_meshes(tmp_path, now)
+
+
+def test_a_log_whose_recorded_config_is_an_alias_bomb_is_moved_aside_not_expanded(tmp_path):
+    from graspexp.run.resume import check_resumable
+
+    bomb = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
+        f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
+        for p, c in zip("abcdefgh", "bcdefghi", strict=True)
+    )
+    _log(tmp_path, config_yaml=bomb)
+    check_resumable(compose_cfg("dataset=primitives"), tmp_path)  # quarantined, never expanded
+    assert [p.name for p in (tmp_path / "trials" / ".quarantine" / "can").iterdir()][0].startswith(
+        "000.mcap."
+    )
