@@ -101,10 +101,12 @@ def wheel(session: nox.Session) -> None:
 
 @nox.session
 def bench(session: nox.Session) -> None:
-    """Planner latency per Table 1 object, the per-phase trial benchmark, then the 720-trial reproduction
+    """Planner latency per Table 1 object, registration accuracy and depth + registration time per Table
+    1/2 object (the camera extra), the per-phase trial benchmark, then the 720-trial reproduction
     (logged, warm collision cache) with 1 and 2 workers."""
-    session.install("-e", ".")
+    session.install("-e", ".[camera]")
     session.run("python", "-m", "graspexp", "bench.plan_latency", *session.posargs, env=ENV)
+    session.run("python", "-m", "graspexp", "bench.registration", *session.posargs, env=ENV)
     session.run("python", "-m", "graspexp", "bench.trials", *session.posargs, env=ENV)
     session.run("python", "-m", "graspexp", "bench.reproduce", *session.posargs, env=ENV)
 
