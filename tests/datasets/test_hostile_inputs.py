@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 import trimesh
-from conftest import compose_cfg
+from helpers.config import compose_cfg
 
 from graspexp.core.userinput import UserInputError, check_object_name, load_user_yaml
 from graspexp.datasets import ObjectError, catalogue, load_object

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 import pandas as pd
 import pytest
 import trimesh
-from conftest import compose_cfg
+from helpers.config import compose_cfg
 
 from graspexp.core.outcome import TrialResult
 from graspexp.core.run_layout import trial_log_path
