@@ -10,6 +10,7 @@ TOOLS: tuple[str, ...] = (
     "readings",
     "benchmark",
     "download",
+    "download_checkpoint",
     "prepare",
     "area",
     "config_reference",

@@ -13,7 +13,13 @@ from graspexp.config.plugins import LoadedPlanner, load_planners
 from graspexp.planning import PlanRequest, plan
 from graspexp.planning.collision import cloud_hits, frame_from_axes, lowest_z
 
-PLANNERS = tuple(sorted(n for n, p in load_planners().items() if isinstance(p, LoadedPlanner)))
+PLANNERS = tuple(
+    sorted(
+        n
+        for n, p in load_planners().items()
+        if isinstance(p, LoadedPlanner) and not p.plugin.needs_observation
+    )
+)
 
 
 def _gripper(*overrides: str):
