@@ -32,7 +32,6 @@ from omegaconf import DictConfig, OmegaConf
 from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
-from graspexp.config import validate
 from graspexp.config.differences import config_differences
 from graspexp.core.outcome import FailureReason, TrialResult, result_from_dict
 from graspexp.core.seeding import trial_seed
@@ -51,6 +50,7 @@ from graspexp.record import (
 from graspexp.record.reader import read_metadata
 from graspexp.record.scene import ObjectScene, object_scene
 from graspexp.record.writer import is_write_error
+from graspexp.run.job_config import make_ready
 from graspexp.run.locks import DirectoryLock, RunError
 from graspexp.run.prepare import prepare_shapes
 from graspexp.sim.collision_shapes import ShapeError, shape_with_fallback
@@ -437,7 +437,7 @@ def run_in_dir(
     """:func:`run_job` into ``run_dir`` (resumable, locked), outside a Hydra run (e.g. the benchmark). The
     config is validated, then frozen: nothing in the job can change it (a write raises). ``on_accepted``
     runs once every check that can refuse the run has passed (before the first trial)."""
-    validate(cfg)
+    make_ready(cfg)
     OmegaConf.set_readonly(cfg, True)
     with threadpool_limits(limits=1):  # trials are sequential: one core per job
         return _run(cfg, run_dir, on_accepted)

@@ -9,11 +9,11 @@ from conftest import compose_cfg, write_urdf_gripper
 from omegaconf import OmegaConf
 from test_grip_force import THIN_M, steady_finger_forces
 
-from graspexp.config import validate
 from graspexp.core.seeding import trial_seed
 from graspexp.datasets import job_object
 from graspexp.planning import plan
 from graspexp.quality import fc_min_mu
+from graspexp.run.job_config import make_ready
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.gripper import build_gripper
 from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
@@ -28,7 +28,7 @@ def urdf(tmp_path):
 
 def test_the_links_carry_the_urdf_pieces(urdf):
     cfg = compose_cfg("gripper=urdf", urdf)
-    validate(cfg)
+    make_ready(cfg)
     gripper_cfg = OmegaConf.to_object(cfg).gripper
     scene = sapien.Scene([sapien.physx.PhysxCpuSystem()])
     grip = build_gripper(scene, gripper_cfg, np.eye(4), support_collides=False)
@@ -46,7 +46,7 @@ def test_grip_force_is_the_configured_one_within_1_percent(urdf, width_m):
 @pytest.mark.parametrize(("mode", "rot", "trial"), [("collab", "z", 0), ("bin", "xyz", 0)])
 def test_a_can_is_grasped_and_held(urdf, mode, rot, trial):
     cfg = compose_cfg("dataset=primitives", "gripper=urdf", urdf, f"mode={mode}", f"rot={rot}")
-    validate(cfg)
+    make_ready(cfg)
     plain = plain_config(cfg)
     model = job_object(cfg, "can")
     ctx = TrialContext(
