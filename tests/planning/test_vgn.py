@@ -27,9 +27,9 @@ from conftest import compose_cfg, shared_data_root  # noqa: E402
 from omegaconf import OmegaConf  # noqa: E402
 
 from graspexp.config import ConfigError  # noqa: E402
-from graspexp.config.gripper import GripperGeometry  # noqa: E402
 from graspexp.config.validate import validate  # noqa: E402
 from graspexp.core import checkpoints  # noqa: E402
+from graspexp.grippers import GripperGeometry  # noqa: E402
 from graspexp.planning import PlanRequest, plan  # noqa: E402
 from graspexp.planning.learned import tsdf, vgn, vgn_network  # noqa: E402
 

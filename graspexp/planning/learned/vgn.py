@@ -27,8 +27,8 @@ from scipy import ndimage
 from scipy.spatial.transform import Rotation
 
 from graspexp.config import GripperConfig
-from graspexp.config.gripper import GripperGeometry
 from graspexp.config.planner.vgn import VgnConfig
+from graspexp.grippers import GripperGeometry
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.learned.tsdf import DepthView, fuse
 from graspexp.planning.learned.vgn_network import GRID, VgnNet, load_vgn
