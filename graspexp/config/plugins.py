@@ -38,19 +38,20 @@ class PlannerPlugin:
     constraints : allowed values of every field of ``config``, inherited ones included
         (``{**BASE_CONSTRAINTS, ...}``; see :mod:`graspexp.config.constraints`).
     version : the planner's version, recorded with every result; default the package's version.
+    needs_observation : the planner reads the depth camera's output (``PlanRequest.observation``): the
+        trial renders the camera for it even with ``perception.source=truth`` (the camera extra must be
+        installed).
     unavailable : optional ``() -> str``: '' when the planner can run on this machine, else one line
         naming what is missing and the command that brings it (an optional extra, a checkpoint); called
         when a config selects the planner, so the run stops before its first trial.
-    needs_observation : the planner plans from the camera's observation (``PlanRequest.observation``)
-        and refuses a request without one.
     """
 
     plan: Callable[..., Any] | str
     config: type[PlannerConfig]
     constraints: Mapping[str, list]
     version: str = ""
-    unavailable: Callable[[], str] | None = None
     needs_observation: bool = False
+    unavailable: Callable[[], str] | None = None
 
 
 @dataclass(frozen=True)

@@ -179,7 +179,7 @@ def test_round_trip_file(trial_file):
         "/contacts": "foxglove.PointCloud",
         "/grasp": "graspexp.PlannedGrasp@1",
         "/phase": "graspexp.Phase@1",
-        "/result": "graspexp.TrialResult@3",
+        "/result": "graspexp.TrialResult@4",
     }
     n = int(RATE_HZ * DURATION_S)
     assert sorted(log.transforms) == ["finger_left", "finger_right", "gripper", "object"]
@@ -310,7 +310,7 @@ def test_scene_entities_follow_foxglove_layout(trial_file):
 
 def test_result_schema_pinned():
     """Changing TrialResult's fields must come with a new graspexp.TrialResult@N version."""
-    assert S.TRIAL_RESULT == "graspexp.TrialResult@3"
+    assert S.TRIAL_RESULT == "graspexp.TrialResult@4"
     assert list(S.SCHEMAS[S.TRIAL_RESULT]["properties"]) == [
         "dataset",
         "object",
