@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import types
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +29,8 @@ from graspexp.config import ConfigError  # noqa: E402
 from graspexp.config.validate import validate  # noqa: E402
 from graspexp.core import checkpoints  # noqa: E402
 from graspexp.grippers import GripperGeometry  # noqa: E402
+from graspexp.perception.camera import BoxBody, MeshBody  # noqa: E402
+from graspexp.perception.observe import observe  # noqa: E402
 from graspexp.planning import PlanRequest, plan  # noqa: E402
 from graspexp.planning.learned import tsdf, vgn, vgn_network  # noqa: E402
 
@@ -37,6 +38,7 @@ pytestmark = pytest.mark.learned
 SHARED_VGN = shared_data_root().parent / "peers" / "vgn"
 """``../shared/peers/vgn``: beside the shared data root (``$GRASPEXP_DATA/..``)."""
 TABLE_Z = 0.1
+"""Support top, m (``mode.support_height_m``)."""
 
 
 @pytest.fixture(autouse=True)
@@ -49,55 +51,26 @@ def _checkpoint_dir(monkeypatch: pytest.MonkeyPatch) -> Path:
     return folder
 
 
-def _look_at(eye: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """world_from_camera (OpenCV axes) of a camera at ``eye`` looking at ``target``, image x horizontal."""
-    z = (target - eye) / np.linalg.norm(target - eye)
-    x = np.cross(z, [0.0, 0.0, 1.0])
-    x /= np.linalg.norm(x)
-    T = np.eye(4)
-    T[:3, :3] = np.column_stack([x, np.cross(z, x), z])
-    T[:3, 3] = eye
-    return T
-
-
-def _cast(meshes, world_from_camera: np.ndarray, K: np.ndarray, w: int, h: int):
-    """Depth (h, w) float32 along the optical axis, and the world points and mesh index of every hit."""
-    scene = o3d.t.geometry.RaycastingScene()
-    for m in meshes:
-        scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(m))
-    rays = scene.create_rays_pinhole(
-        o3d.core.Tensor(K), o3d.core.Tensor(np.linalg.inv(world_from_camera)), w, h
-    ).numpy()
-    hit = scene.cast_rays(o3d.core.Tensor(rays))
-    t, which = hit["t_hit"].numpy(), hit["geometry_ids"].numpy()
-    depth = t * (rays[..., 3:] @ world_from_camera[:3, 2])
-    seen = np.isfinite(depth)
-    points = rays[..., :3][seen] + t[seen, None] * rays[..., 3:][seen]
-    return np.where(seen, depth, 0.0).astype(np.float32), points, which[seen]
-
-
-def _box(size, centre) -> o3d.geometry.TriangleMesh:
-    m = o3d.geometry.TriangleMesh.create_box(*size)
-    return m.translate(np.asarray(centre) - np.asarray(size) / 2)
-
-
-def _scene(size=(0.05, 0.08, 0.12), xy=(0.4, 0.1), n_views: int = 6):
-    """A box standing on a table at TABLE_Z seen by ``n_views`` cameras 0.6 m away, 30 degrees off vertical
-    (VGN's viewpoints), 640 x 480 px, fx = 540 px: an observation as the camera gives one (target id 1)."""
-    centre = np.array([*xy, TABLE_Z])
-    meshes = [_box((1.0, 1.0, 0.02), centre - [0, 0, 0.01]), _box(size, centre + [0, 0, size[2] / 2])]
-    K = np.array([[540.0, 0.0, 320.0], [0.0, 540.0, 240.0], [0.0, 0.0, 1.0]])
-    views, points, ids = [], [], []
-    for phi in 2 * np.pi * np.arange(n_views) / n_views:
-        eye = centre + 0.6 * np.array([0.5 * np.cos(phi), 0.5 * np.sin(phi), np.sqrt(3) / 2])
-        pose = _look_at(eye, centre)
-        depth, pts, which = _cast(meshes, pose, K, 640, 480)
-        views.append(types.SimpleNamespace(depth=depth, K=K, world_from_camera=pose, name=f"v{len(views)}"))
-        points.append(pts)
-        ids.append(which.astype(np.int32))  # mesh 0 (table) -> id 0, mesh 1 (box) -> id 1
-    cloud = np.concatenate(points)
-    obs = types.SimpleNamespace(views=tuple(views), points=cloud, point_ids=np.concatenate(ids), target_id=1)
-    return obs, centre + [0, 0, size[2] / 2], np.asarray(size)
+def _scene(size=(0.05, 0.08, 0.12), azimuths=(0.0, 120.0, 240.0), mesh=None, seed: int = 0, noise=True):
+    """A box (or ``mesh``, resting on the support) at the support's centre in bin mode, seen by the
+    simulated depth camera (the D435 preset, its noise model on unless ``noise`` is False) from
+    ``azimuths``: the camera's observation (target id 1), the object's world pose and its mesh in its own
+    frame."""
+    cfg = OmegaConf.to_object(
+        compose_cfg(
+            "mode=bin",
+            f"perception.camera.azimuths_deg={list(azimuths)}",
+            f"perception.depth_noise.enabled={noise}",
+        )
+    )
+    mesh = trimesh.creation.box(size) if mesh is None else mesh
+    pose = np.eye(4)
+    pose[:3, 3] = [0.0, 0.0, TABLE_Z - mesh.bounds[0, 2]]
+    half = tuple(cfg.mode.support_half_size_m)
+    support = BoxBody(np.array([-half[0], -half[1], 0.0]), np.array([half[0], half[1], TABLE_Z]))
+    rng = np.random.default_rng(seed)
+    obs = observe(cfg.perception, [MeshBody(mesh, pose, 1)], [support], TABLE_Z, 1, rng=rng)
+    return obs, pose, mesh
 
 
 def _request(obs, seed: int = 3, *overrides: str) -> PlanRequest:
@@ -106,10 +79,7 @@ def _request(obs, seed: int = 3, *overrides: str) -> PlanRequest:
     req = PlanRequest(
         empty, empty, np.zeros(0, bool), np.eye(4), TABLE_Z, "bin", cfg.gripper, cfg.planner, cfg.cost, seed
     )
-    if "observation" in {f.name for f in dataclasses.fields(PlanRequest)}:
-        return dataclasses.replace(req, observation=obs)
-    object.__setattr__(req, "observation", obs)  # before the camera's PlanRequest.observation lands
-    return req
+    return dataclasses.replace(req, observation=obs)
 
 
 def test_the_checkpoint_loads_strictly_and_its_outputs_are_deterministic():
@@ -157,7 +127,7 @@ def test_a_missing_checkpoint_or_extra_stops_the_config_with_one_line(tmp_path, 
 def test_the_fused_grid_is_vgns_voxel_cloud_of_open3d():
     """The grid read from Open3D's volume equals VGN's route: the voxel point cloud (values in its
     colours) placed at floor(point / voxel)."""
-    obs, _, _ = _scene(n_views=2)
+    obs, _, _ = _scene(azimuths=(0.0, 180.0), noise=False)
     corner = vgn.world_from_volume(obs.points[obs.point_ids == 1], TABLE_Z)
     views = [tsdf.DepthView(v.depth, v.K, v.world_from_camera) for v in obs.views]
     grid = tsdf.fuse(views, corner, 0.3, 40, 2.0)
@@ -171,7 +141,8 @@ def test_the_fused_grid_is_vgns_voxel_cloud_of_open3d():
         rgbd = o3d.geometry.RGBDImage.create_from_color_and_depth(
             o3d.geometry.Image(np.zeros_like(v.depth)), o3d.geometry.Image(v.depth), 1.0, 2.0, False
         )
-        intrinsic = o3d.camera.PinholeCameraIntrinsic(640, 480, 540.0, 540.0, 320.0, 240.0)
+        (h, w), K = v.depth.shape, v.K
+        intrinsic = o3d.camera.PinholeCameraIntrinsic(w, h, K[0, 0], K[1, 1], K[0, 2], K[1, 2])
         volume.integrate(rgbd, intrinsic, np.linalg.inv(v.world_from_camera) @ corner)
     cloud = volume.extract_voxel_point_cloud()
     expected = np.zeros((40, 40, 40), np.float32)
@@ -180,8 +151,8 @@ def test_the_fused_grid_is_vgns_voxel_cloud_of_open3d():
     ]
     assert (grid > 0).sum() > 1000
     np.testing.assert_array_equal(grid, expected)
-    # beside the box, the table top (0.05 m above the floor: 6.67 voxels) crosses 0.5 between the voxel
-    # centres of layers 6 (48.75 mm) and 7 (56.25 mm), rising with height
+    # beside the box, the exact table top (0.05 m above the floor: 6.67 voxels) crosses 0.5 between the
+    # voxel centres of layers 6 (48.75 mm) and 7 (56.25 mm), rising with height
     column = grid[5, 20, :]
     assert 0 < column[5] < column[6] < 0.5 < column[7] < column[8]
 
@@ -217,29 +188,31 @@ def test_detection_keeps_thresholded_local_maxima_near_the_surface_with_widths_i
     assert len(smoothed.poses) == 0  # a lone voxel of 1.0 smooths to about 0.06 < 0.9
 
 
-def test_a_plan_on_a_rendered_box_straddles_it_and_repeats():
-    obs, centre, size = _scene()
-    req = _request(obs)
-    g = plan(req).grasp
-    assert g.planner == "vgn" and g.width_m == req.gripper.max_width_m
-    R = g.pose[:3, :3]
-    np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-6)
-    # the fingers straddle the box: points of its surface lie between the pads, none where a pad is
+def _straddles(g, req: PlanRequest, mesh: trimesh.Trimesh, pose: np.ndarray) -> bool:
+    """Whether the fingers of grasp ``g`` straddle ``mesh`` at ``pose``: points of its surface lie between
+    the pads, none where a pad is (finger boxes of ``req.gripper``, opened to ``g.width_m``)."""
     geo = GripperGeometry.of(req.gripper)
-    box = trimesh.creation.box(size, trimesh.transformations.translation_matrix(centre))
-    local = (trimesh.sample.sample_surface_even(box, 20000, seed=1)[0] - g.position) @ R
+    surface = trimesh.sample.sample_surface_even(mesh, 20000, seed=1)[0] @ pose[:3, :3].T + pose[:3, 3]
+    local = (surface - g.position) @ g.pose[:3, :3]
     slab = (
         (np.abs(local[:, 0]) <= geo.finger_width_m / 2)
         & (local[:, 2] >= geo.root_z_m)
         & (local[:, 2] <= geo.tip_z_m)
     )
-    between = slab & (np.abs(local[:, 1]) < g.width_m / 2)
-    in_pad = (
-        slab
-        & (np.abs(local[:, 1]) >= g.width_m / 2)
-        & (np.abs(local[:, 1]) <= g.width_m / 2 + geo.finger_thickness_m)
+    gap = np.abs(local[:, 1]) - g.width_m / 2
+    return bool(
+        (slab & (gap < 0)).sum() > 50 and not (slab & (gap >= 0) & (gap <= geo.finger_thickness_m)).any()
     )
-    assert between.sum() > 50 and in_pad.sum() == 0
+
+
+def test_a_plan_on_a_rendered_box_straddles_it_and_repeats():
+    obs, pose, mesh = _scene()
+    req = _request(obs)
+    g = plan(req).grasp
+    assert g.planner == "vgn" and g.width_m == req.gripper.max_width_m
+    R = g.pose[:3, :3]
+    np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-6)
+    assert _straddles(g, req, mesh, pose)
     approach = R[:, 2]
     assert approach[2] < -0.5  # from above, as VGN's training grasps (normals pointing up)
     assert g.extras["quality"] >= 0.9 and g.extras["infer_cpu_s"] > 0
@@ -252,11 +225,22 @@ def test_a_plan_on_a_rendered_box_straddles_it_and_repeats():
 def test_no_observation_or_no_target_point_is_a_recorded_reason():
     from graspexp.planning import NoFeasibleGrasp
 
-    obs, _, _ = _scene(n_views=1)
-    req = _request(obs)
-    object.__setattr__(req, "observation", None)
+    obs, _, _ = _scene(azimuths=(0.0,))
+    req = dataclasses.replace(_request(obs), observation=None)
     with pytest.raises(NoFeasibleGrasp, match="no observation"):
         plan(req)
-    blind = types.SimpleNamespace(**{**vars(obs), "target_id": 7})
+    blind = dataclasses.replace(obs, target_id=7)
     with pytest.raises(NoFeasibleGrasp, match=r"saw no point of the target \(id 7\)"):
         plan(_request(blind))
+
+
+def test_a_plan_on_a_rendered_ycb_object_straddles_it(data_root):
+    """The soup can (Table 1) upright on the support, one D435 view as in a trial."""
+    from graspexp.datasets import load_object
+
+    cfg = compose_cfg("dataset=ycb", f"dataset.root={data_root}")
+    model = load_object(cfg.dataset, "005_tomato_soup_can", 256, 0)
+    obs, pose, mesh = _scene(azimuths=(0.0,), mesh=model.mesh)
+    req = _request(obs)
+    g = plan(req).grasp
+    assert _straddles(g, req, mesh, pose), g
