@@ -137,7 +137,7 @@ def test_planning_loads_neither_hydra_nor_sapien():
 
 def test_tests_are_laid_out_by_stage():
     tests = Path(__file__).parent
-    dirs = {p.name for p in tests.iterdir() if p.is_dir() and not p.name.startswith((".", "_"))}
+    dirs = {p.name for p in tests.iterdir() if p.is_dir() and not p.name.startswith((".", "_"))} - {"helpers"}
     assert {*STAGES, TOOLS_PACKAGE} - OPTIONAL_STAGES <= dirs <= {*STAGES, TOOLS_PACKAGE}, dirs
     assert sorted(p.name for p in tests.glob("*.py")) == ["conftest.py", "test_architecture.py"]
 
@@ -146,6 +146,8 @@ FILE_READERS = frozenset({"trimesh", "xml", "open3d", "sapien", "pymeshfix", "co
 """Libraries that read mesh or URDF files: the config stage imports none of them."""
 FILE_CALLS = frozenset({"open", "read_text", "read_bytes", "load_hand", "hand_of"})
 """Calls that open a file (or a gripper's URDF): the config stage makes none of them."""
+READS_PRESETS = frozenset({"reference.py"})
+"""config/ modules that read the presets' own YAML (``conf/``) to document them: never a mesh or URDF."""
 
 
 def test_the_config_stage_opens_no_mesh_or_urdf_file():
@@ -161,7 +163,7 @@ def test_the_config_stage_opens_no_mesh_or_urdf_file():
             elif isinstance(node, ast.Call):
                 f = node.func
                 name = f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else ""
-                if name in FILE_CALLS:
+                if name in FILE_CALLS and path.name not in READS_PRESETS:
                     wrong.append(f"{path.relative_to(PACKAGE)}:{node.lineno} calls {name}")
                 continue
             else:

@@ -6,6 +6,7 @@ import numpy as np
 
 from graspexp.config import CostConfig, GripperConfig, PlannerConfig
 from graspexp.perception.observation import Observation
+from graspexp.planning.details import PaperDetails
 from graspexp.planning.grasp import Grasp
 
 
@@ -48,7 +49,14 @@ class PlanRequest:
 
 @dataclass(frozen=True)
 class PlanResult:
-    """A grasp plus every intermediate a figure or test may want (keys as in ``+dump=FILE.npz``)."""
+    """A grasp plus every intermediate a figure or test may want: a typed record
+    (:mod:`graspexp.planning.details`) for the paper's planners, a dict of arrays for the others."""
 
     grasp: Grasp
-    details: dict[str, np.ndarray] = field(default_factory=dict)
+    details: PaperDetails | dict[str, np.ndarray] = field(default_factory=dict)
+
+    def detail_arrays(self) -> dict[str, np.ndarray]:
+        """The intermediates as named arrays (what ``plan --dump`` writes)."""
+        if isinstance(self.details, PaperDetails):
+            return self.details.arrays()
+        return {key: np.asarray(value) for key, value in self.details.items()}

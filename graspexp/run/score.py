@@ -14,6 +14,7 @@ from pathlib import Path
 import pandas as pd
 from omegaconf import OmegaConf
 
+from graspexp.core.run_layout import results_csv
 from graspexp.report.study import SweepStudy
 from graspexp.report.tuning import ScoredSet
 from graspexp.run.job_config import compose_job
@@ -54,6 +55,6 @@ def score_study(
         run_dir = sweep_dir / "score" / f"{split}_{name.replace(' ', '')}"
         t0 = time.perf_counter()
         run_in_dir(job, run_dir)
-        results = pd.read_csv(run_dir / "results.csv")
+        results = pd.read_csv(results_csv(run_dir))
         out.append(ScoredSet(name, params, results, run_dir, time.perf_counter() - t0, number))
     return out

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from graspexp.report.paper import PAPER_TABLES, SETTINGS, TRIALS_PER_SETTING
+from graspexp.run.multirun import multirun_command
 
 
 def sweep_values(key: str, values: tuple[str, ...] | list[str]) -> str:
@@ -207,19 +208,9 @@ def reading_sweep(reading: Reading, out: Path, overrides: tuple[str, ...] | list
         for o in (sweep_values("dataset", PAPER_DATASETS), f"trials={TRIALS_PER_SETTING}")
         if o.split("=", 1)[0] not in given
     ]
-    return [
-        sys.executable,
-        "-m",
-        "graspexp",
-        "-m",
-        *SETTINGS_SWEEP,
-        *defaults,
-        "progress=false",
-        "hydra/launcher=joblib",
-        f"hydra.sweep.dir={out / reading.name}",
-        *reading.overrides,
-        *overrides,
-    ]
+    return multirun_command(
+        out / reading.name, [*SETTINGS_SWEEP, *defaults, "progress=false", *reading.overrides, *overrides]
+    )
 
 
 NOISE_LEVELS: tuple[tuple[float, float], ...] = ((10.0, 0.0), (20.0, 0.0), (0.0, 10.0))

@@ -2,7 +2,7 @@
 
 - ``--option``: the tool's own options, parsed by :mod:`argparse` from :func:`tool_parser` (``-h`` /
   ``--help`` says ``graspexp <tool>``; a bad option is ``usage`` plus one error line, exit status 2).
-- ``key=value``: Hydra overrides of the job config (``graspexp/conf/config.yaml``), for the tools that take
+- ``key=value``: Hydra overrides of the job config (``conf/config.yaml``), for the tools that take
   one. They are composed by :func:`graspexp.run.job_config.compose_job`, the one place that composes
   outside a Hydra run, which raises :class:`~graspexp.config.ConfigError`; :func:`compose_checked` turns it
   into one ``graspexp <tool>: error:`` line and exit status 2.

@@ -18,9 +18,9 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from graspexp.core.checkpoints import CHECKPOINTS, CHECKPOINTS_ENV, checkpoint_dir
+from graspexp.datasets.download import fetch
 from graspexp.datasets.errors import DatasetError
 from graspexp.tools.cli import tool_parser
-from graspexp.tools.download import fetch
 
 PROG = "graspexp download_checkpoint"
 

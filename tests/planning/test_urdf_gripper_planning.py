@@ -4,7 +4,8 @@ a rounded fingertip is seen by its real shape; every planner plans with a URDF g
 import numpy as np
 import pytest
 import trimesh
-from conftest import compose_cfg, write_urdf_gripper
+from helpers.config import compose_cfg
+from helpers.objects import write_urdf_gripper
 from omegaconf import OmegaConf
 
 from graspexp.config.plugins import LoadedPlanner, load_planners

@@ -22,7 +22,7 @@ o3d = pytest.importorskip(
     "open3d", reason="planner=vgn needs the optional extra: pip install -e '.[learned]'"
 )
 
-from conftest import compose_cfg, shared_data_root  # noqa: E402
+from helpers.config import compose_cfg, shared_data_root  # noqa: E402
 from omegaconf import OmegaConf  # noqa: E402
 
 from graspexp.config import ConfigError  # noqa: E402

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import strictly_valid
+from helpers.logs import strictly_valid
 from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory
 

@@ -6,13 +6,14 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import strictly_valid, write_urdf_gripper
+from helpers.logs import strictly_valid
+from helpers.objects import write_urdf_gripper
 
 from graspexp.core.bodies import FINGER_NAMES, PALM_NAME
 from graspexp.record import read_trial
 from graspexp.record.reader import iter_trial_logs
 
-pytestmark = [pytest.mark.sim, pytest.mark.slow]
+pytestmark = pytest.mark.slow
 REPO = Path(__file__).resolve().parents[2]
 
 

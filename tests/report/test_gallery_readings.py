@@ -15,7 +15,7 @@ from graspexp.report.readings import MixedConfigError, readings_report
 from graspexp.run.suites import ALL, READINGS, reading_sweep
 from graspexp.tools.readings import main as readings_main
 
-pytestmark = [pytest.mark.sim, pytest.mark.slow]
+pytestmark = pytest.mark.slow
 REPO = Path(__file__).resolve().parents[2]
 OBJECTS = "objects=[box,block,mug]"
 

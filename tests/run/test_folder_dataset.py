@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import trimesh
-from conftest import REPO, make_object_folder
+from helpers.config import REPO
+from helpers.objects import make_object_folder
 
 from graspexp.record.reader import read_metadata
 

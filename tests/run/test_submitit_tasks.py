@@ -13,7 +13,7 @@ import pytest
 
 from graspexp.run.launchers import task_failure
 
-pytestmark = [pytest.mark.sim, pytest.mark.slow]
+pytestmark = pytest.mark.slow
 REPO = Path(__file__).resolve().parents[2]
 
 

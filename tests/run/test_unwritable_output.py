@@ -11,7 +11,7 @@ import pytest
 
 from graspexp.record import read_trial
 
-pytestmark = [pytest.mark.sim, pytest.mark.slow]
+pytestmark = pytest.mark.slow
 REPO = Path(__file__).resolve().parents[2]
 JOB = [sys.executable, "-m", "graspexp", "dataset=primitives", "objects=[can]", "progress=false"]
 

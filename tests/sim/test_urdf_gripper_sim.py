@@ -5,20 +5,15 @@ grasps and holds in both modes."""
 import numpy as np
 import pytest
 import sapien
-from conftest import compose_cfg, write_urdf_gripper
+from helpers.config import compose_cfg
+from helpers.objects import write_urdf_gripper
+from helpers.sim import THIN_M, steady_finger_forces
 from omegaconf import OmegaConf
-from test_grip_force import THIN_M, steady_finger_forces
 
-from graspexp.core.seeding import trial_seed
-from graspexp.datasets import job_object
-from graspexp.planning import plan
-from graspexp.quality import fc_min_mu
 from graspexp.run.job_config import make_ready
-from graspexp.sim.collision_shapes import collision_shape
+from graspexp.run.objects import load_object, trial_context
 from graspexp.sim.gripper import build_gripper
-from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
-
-pytestmark = pytest.mark.sim
+from graspexp.sim.trial import plain_config, run_trial
 
 
 @pytest.fixture
@@ -48,18 +43,7 @@ def test_a_can_is_grasped_and_held(urdf, mode, rot, trial):
     cfg = compose_cfg("dataset=primitives", "gripper=urdf", urdf, f"mode={mode}", f"rot={rot}")
     make_ready(cfg)
     plain = plain_config(cfg)
-    model = job_object(cfg, "can")
-    ctx = TrialContext(
-        plain,
-        model,
-        collision_shape(model.mesh, plain.sim),
-        trial,
-        trial_seed(plain, "can", trial),
-        NullRecorder(),
-        plan=plan,
-        quality=fc_min_mu,
-    )
-    res = run_trial(ctx)
+    res = run_trial(trial_context(plain, load_object(cfg, "can", plain), trial))
     assert res.success, res
     assert (
         min(res.finger_force_n) > 0.9 * plain.gripper.grip_force_n

@@ -9,7 +9,7 @@ import threading
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 
 import pytest
-from conftest import shared_data_root
+from helpers.config import shared_data_root
 
 from graspexp.core import checkpoints
 from graspexp.tools import download_checkpoint

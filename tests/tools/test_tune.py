@@ -60,7 +60,6 @@ def study_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 @pytest.mark.slow
-@pytest.mark.sim
 def test_study_objective_is_each_jobs_mean_success(study_dir: Path) -> None:
     study = read_sweep_study(study_dir).study
     trials = study.get_trials()
@@ -78,7 +77,6 @@ def test_study_objective_is_each_jobs_mean_success(study_dir: Path) -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.sim
 def test_study_resumes_to_n_trials_in_all(study_dir: Path) -> None:
     before = {t.params["cost.angle_weight"] for t in read_sweep_study(study_dir).study.get_trials()}
     _graspexp("-m", *STUDY, "hydra.sweeper.n_trials=4", f"hydra.sweep.dir={study_dir}")
@@ -93,7 +91,6 @@ def test_study_resumes_to_n_trials_in_all(study_dir: Path) -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.sim
 def test_tune_scores_best_and_paper_on_the_test_split(study_dir: Path, tmp_path: Path) -> None:
     preset = tmp_path / "tuned.yaml"
     _graspexp("tune", str(study_dir), "--trials", "1", "--out", str(tmp_path), "--preset", str(preset))

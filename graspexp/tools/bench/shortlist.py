@@ -5,7 +5,7 @@ beside what the planner measured of it.
         [rot=z,xyz] [dataset=ycb,linemod] [objects=[a,b]] [key=value ...]
 
 For each dataset, setting, object and trial the planner runs once; each of its S shortlisted paths
-(``details["shortlist_*"]``, graspexp/planning/optimal_plus.py) is then executed in a fresh trial on the
+(``details.shortlist``, graspexp/planning/optimal_plus.py) is then executed in a fresh trial on the
 same drop by a planner that returns that grasp. One CSV row per simulated grasp: held or not, the failure
 reason, the edge excess (how far the object reaches past a pad's contact plane by the finger edges, the
 measure ``choose_by=edge_clearance`` minimises), the pad depth, whether it passed the noise check, and
@@ -27,15 +27,13 @@ import pandas as pd
 from threadpoolctl import threadpool_limits
 
 from graspexp.config.compose import compose_config
-from graspexp.core.seeding import trial_seed
-from graspexp.datasets import available_objects, job_object
+from graspexp.datasets import available_objects
 from graspexp.planning import plan
 from graspexp.planning.optimal_plus import pick_shortlisted
 from graspexp.planning.request import PlanResult
-from graspexp.quality import fc_min_mu
+from graspexp.run.objects import load_object, trial_context
 from graspexp.run.suites import PAPER_DATASETS, PAPER_MODES, PAPER_ROTS
-from graspexp.sim.collision_shapes import collision_shape
-from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
+from graspexp.sim.trial import plain_config, run_trial
 from graspexp.tools.cli import compose_checked, fail, positive_int, take_sweep, tool_parser
 
 PROG = "graspexp bench.shortlist"
@@ -51,11 +49,9 @@ def _forced(j: int, seen: dict):
 
     def planner(req):
         res = seen.get("plan") or seen.setdefault("plan", plan(req))
-        d = res.details
-        grasp = dataclasses.replace(
-            res.grasp, pose=d["shortlist_poses"][j], width_m=float(d["shortlist_widths"][j])
-        )
-        return PlanResult(grasp=grasp, details=d)
+        short = res.details.shortlist
+        grasp = dataclasses.replace(res.grasp, pose=short.poses[j], width_m=float(short.widths[j]))
+        return PlanResult(grasp=grasp, details=res.details)
 
     return planner
 
@@ -66,22 +62,17 @@ def _job(args: tuple[list[str], str, int]) -> list[dict]:
     threadpool_limits(limits=1)
     cfg = compose_config(overrides)
     plain = plain_config(cfg)
-    model = job_object(cfg, name)
-    hulls = collision_shape(model.mesh, plain.sim)
+    loaded = load_object(cfg, name, plain)
     rows = []
     for i in range(trials):
-        seed = trial_seed(plain, name, i)
         seen: dict = {}
         j, n = 0, 1
         while j < n:
-            ctx = TrialContext(
-                plain, model, hulls, i, seed, NullRecorder(), plan=_forced(j, seen), quality=fc_min_mu
-            )
-            res = run_trial(ctx)
+            res = run_trial(trial_context(plain, loaded, i, plan=_forced(j, seen)))
             if "plan" not in seen:  # no grasp planned for this drop: nothing to compare
                 break
-            d = seen["plan"].details
-            n = len(d["shortlist_costs"])
+            short = seen["plan"].details.shortlist
+            n = len(short.costs)
             rows.append(
                 {
                     "object": name,
@@ -89,15 +80,13 @@ def _job(args: tuple[list[str], str, int]) -> list[dict]:
                     "candidate": j,
                     "held": res.success,
                     "reason": res.reason or "",
-                    "edge_excess_mm": 1000 * float(d["shortlist_edge_excess_m"][j]),
-                    "pad_depth_mm": 1000 * float(d["shortlist_pad_depth_m"][j]),
-                    "robust": bool(d["shortlist_robust"][j]),
-                    "cost": float(d["shortlist_costs"][j]),
+                    "edge_excess_mm": 1000 * float(short.edge_excess_m[j]),
+                    "pad_depth_mm": 1000 * float(short.pad_depth_m[j]),
+                    "robust": bool(short.robust[j]),
+                    "cost": float(short.costs[j]),
                     **{
                         f"pick_{rule}": j
-                        == pick_shortlisted(
-                            rule, d["shortlist_costs"], d["shortlist_robust"], d["shortlist_edge_excess_m"]
-                        )
+                        == pick_shortlisted(rule, short.costs, short.robust, short.edge_excess_m)
                         for rule in RULES
                     },
                 }
