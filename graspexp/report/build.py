@@ -115,7 +115,7 @@ def _agreement_display(ag: Agreement, pictures: dict[tuple[str, str, str], str])
     )
 
 
-def _agreement_section(ag: Agreement, results: pd.DataFrame, out: Path) -> list[str]:
+def agreement_section(ag: Agreement, results: pd.DataFrame, out: Path) -> list[str]:
     """Write ``agreement_<dataset>_<planner>.{md,csv,png}`` and a picture of each flagged cell's failure;
     returns the report.md lines."""
     pictures = {}
@@ -177,7 +177,7 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
         md += [f"{i}. {note}" for i, note in enumerate(footnotes(table), 1)]
         md += ["", f"![{table.name}]({table.name}.png)", ""]
     for ag in report.agreements:
-        md += _agreement_section(ag, col.results, out)
+        md += agreement_section(ag, col.results, out)
     if not report.failures.empty:
         (out / "failures.md").write_text(markdown(report.failures, index=False) + "\n")
         (out / "failures.tex").write_text(latex(report.failures, "Failure reasons per setting", index=False))

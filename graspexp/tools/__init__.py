@@ -14,6 +14,7 @@ TOOLS: tuple[str, ...] = (
     "area",
     "config_reference",
     "tune",
+    "results",
     "bench.trials",
     "bench.reproduce",
     "bench.plan_latency",
