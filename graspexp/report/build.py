@@ -21,6 +21,7 @@ import pandas as pd
 from graspexp.record import CorruptLogError, read_trial
 from graspexp.report.agreement import Agreement, agreement, agreement_chart, example_trials
 from graspexp.report.charts import success_chart
+from graspexp.report.citations import DETERMINISM
 from graspexp.report.collect import FINGERPRINT_COLUMN, Collected, collect
 from graspexp.report.contact_area import held_in_area
 from graspexp.report.gallery import draw_trial, write_gallery
@@ -243,7 +244,7 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
         counts = col.results[FINGERPRINT_COLUMN].fillna("results.csv only (no log)").value_counts()
         md += ["## Machines and versions", ""]
         md += [
-            "Trial results may depend on the CPU and the libraries (README, Determinism); these logs were made on:",
+            f"Trial results may depend on the CPU and the libraries {DETERMINISM.cite()}; these logs were made on:",
             "",
         ]
         md += [f"- {n} trials: {name}" for name, n in counts.items()] + [""]

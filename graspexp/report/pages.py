@@ -74,7 +74,8 @@ def outcome_fingerprint(tables: Iterable[pd.DataFrame]) -> str:
     frames = [t.reindex(columns=[*OUTCOME_KEYS, *OUTCOME_COLUMNS]) for t in tables]
     if not frames:
         raise ValueError("a fingerprint needs at least one results table")
-    rows = pd.concat(frames, ignore_index=True).fillna("").astype(str)
+    rows = pd.concat(frames, ignore_index=True)
+    rows = rows.astype(object).where(rows.notna(), "").astype(str)
     rows = rows.sort_values(list(OUTCOME_KEYS), kind="stable")
     text = rows.to_csv(index=False, lineterminator="\n")
     return hashlib.sha256(text.encode()).hexdigest()[:16]
