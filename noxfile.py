@@ -72,11 +72,8 @@ def reproduce(session: nox.Session) -> None:
     suite_overrides = [o for o in suite.split() if o.split("=")[0] not in given]
     start = time.perf_counter()
     session.run(
-        "python", "-m", "graspexp", "-m", *suite_overrides, "progress=false",
-        "hydra/launcher=joblib", f"hydra.sweep.dir={out}", *extra,
-        env=ENV,
-        external=True,
-    )  # fmt: skip
+        "python", "-m", "graspexp.run.multirun", out, *suite_overrides, *extra, env=ENV, external=True
+    )
     sweep_s = time.perf_counter() - start
     session.run("python", "-m", "graspexp", "report", out, env=ENV, external=True)
     total_s = time.perf_counter() - start
@@ -94,11 +91,10 @@ def compare(session: nox.Session) -> None:
     extra = list(session.posargs[1:])
     start = time.perf_counter()
     session.run(
-        "python", "-m", "graspexp", "-m",
+        "python", "-m", "graspexp.run.multirun", out,
         "planner=optimal,optimal_in_area,optimal_plus,antipodal,obb,random",
         "perception.noise.trans_mm=0,10,20", "perception.noise.rot_deg=0,10",
-        "dataset=primitives", "objects=[can,mug,banana]", "mode=bin", "rot=z", "trials=3",
-        "progress=false", "hydra/launcher=joblib", f"hydra.sweep.dir={out}", *extra,
+        "dataset=primitives", "objects=[can,mug,banana]", "mode=bin", "rot=z", "trials=3", *extra,
         env=ENV, external=True,
     )  # fmt: skip
     session.run("python", "-m", "graspexp", "compare", out, "--out", f"{out}/compare", env=ENV, external=True)

@@ -24,6 +24,8 @@ import sys
 import time
 from pathlib import Path
 
+from graspexp.run.multirun import multirun_command
+
 REPO = Path(__file__).resolve().parents[1]
 NAME = "graspexp-slurm-check"
 SWEEP = ["mode=collab,bin", "rot=z", "dataset=primitives", "objects=[can,box]", "trials=40", "progress=false"]
@@ -50,8 +52,8 @@ def fail(message: str) -> None:
     raise SystemExit(1)
 
 
-def sweep(out: Path, *extra: str) -> list[str]:
-    return [sys.executable, "-m", "graspexp", "-m", *SWEEP, f"hydra.sweep.dir={out}", *extra]
+def sweep(out: Path, *launcher: str) -> list[str]:
+    return multirun_command(out, SWEEP, launcher=launcher)
 
 
 def run(cmd: list[str], timeout: float = 600) -> subprocess.CompletedProcess:

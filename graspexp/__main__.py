@@ -25,7 +25,8 @@ register_configs()
 def _job(cfg: DictConfig) -> float | None:
     from graspexp.datasets import DatasetError
     from graspexp.record.live import LiveViewError
-    from graspexp.run.runner import RunError, run_job
+    from graspexp.run.locks import RunError
+    from graspexp.run.runner import run_job
 
     try:
         return run_job(cfg)

@@ -25,8 +25,18 @@ SCHEMAS = {
 }
 """The schema of each group with one schema; the ``planner`` group has one per planner (its plugin's)."""
 
-CONF_DIR = str(Path(__file__).resolve().parent.parent / "conf")
-"""The YAML config tree shipped inside the package (``graspexp/conf/<group>/<option>.yaml``)."""
+
+def _conf_dir() -> Path:
+    """The YAML tree: ``graspexp/conf`` in an installed wheel (the package ``graspexp.conf``), else the
+    checkout's top-level ``conf/`` (a source tree or an editable install)."""
+    package = Path(__file__).resolve().parent.parent
+    installed = package / "conf"
+    return installed if (installed / "config.yaml").is_file() else package.parent / "conf"
+
+
+CONF_DIR = str(_conf_dir())
+"""The YAML config tree, ``conf/<group>/<option>.yaml``: the repository's top-level ``conf/``, which the
+wheel ships as ``graspexp/conf`` (``setup.py``)."""
 
 
 def _yaml_options(group: str) -> set[str]:

@@ -4,7 +4,8 @@ Every key's allowed values are declared as data next to its schema (``CONSTRAINT
 module, see :mod:`graspexp.config.constraints`); this module walks the composed config against the
 schemas: unknown keys (``+foo=1``), keys left without a value (``???``), values out of range,
 and the few relations between keys. Every message is one line naming the dotted key, the value and the
-allowed range.
+allowed range. Only values are checked: nothing here reads a file or writes into the config (a URDF
+gripper's file is read, and the values it gives are filled in, by :func:`graspexp.grippers.fill_gripper`).
 """
 
 import dataclasses
@@ -15,7 +16,6 @@ from omegaconf import DictConfig, OmegaConf
 from graspexp.config import cost, dataset, gripper, job, mode, rot, sim
 from graspexp.config.constraints import accepts, describe
 from graspexp.config.errors import ConfigError
-from graspexp.config.gripper_urdf import UrdfError
 from graspexp.config.plugins import PluginError, get_plugin
 from graspexp.config.registry import SCHEMAS, group_options
 
@@ -43,6 +43,8 @@ RELATIONS = (
 URDF_OPTION = "urdf"
 """The gripper option that reads ``gripper.urdf`` (conf/gripper/urdf.yaml): without a file it has no
 geometry (a ``???`` in its YAML would not override the schema's None)."""
+FROM_URDF = frozenset({"max_width_m", "palm_size_m"})
+"""Gripper keys a URDF gripper may leave unset: its file gives them (:func:`graspexp.grippers.fill_gripper`)."""
 
 
 def _fields(schema: type) -> dict[str, dataclasses.Field]:
@@ -63,6 +65,8 @@ def _check_node(node: DictConfig, schema: type, prefix: str, constraints: dict |
     for name, field in fields.items():
         dotted = prefix + name
         if OmegaConf.is_missing(node, name):
+            if schema is gripper.GripperConfig and name in FROM_URDF and node.urdf is not None:
+                continue
             _missing(dotted)
         value = node[name]
         if schema is job.JobConfig and name == "planner":
@@ -103,29 +107,10 @@ def _check_relations(cfg: DictConfig) -> None:
             raise ConfigError(f"{left}={a!r} is invalid: expected {op} {right}={b!r}")
 
 
-def _check_urdf_gripper(node: DictConfig) -> None:
-    """Read the URDF of a ``gripper.urdf`` (one line naming the file when it is not a parallel gripper) and
-    set an unset ``gripper.max_width_m`` to its stroke (a set one must not exceed it) and an unset
-    ``gripper.palm_size_m`` to the palm's bounding box."""
-    if not isinstance(node, DictConfig) or "urdf" not in node.keys():
-        return
-    if node.urdf is None:
-        if node.get("name") == URDF_OPTION:
-            _missing("gripper.urdf")
-        return
-    try:
-        hand = gripper.hand_of(node)
-    except UrdfError as exc:
-        raise ConfigError(f"gripper.urdf={node.urdf!r} is invalid: {exc}") from None
-    if OmegaConf.is_missing(node, "palm_size_m"):
-        node.palm_size_m = list(gripper.GripperGeometry.of_hand(hand).palm_size_m)
-    if OmegaConf.is_missing(node, "max_width_m"):
-        node.max_width_m = hand.max_width_m
-    elif node.max_width_m > hand.max_width_m + 1e-9:
-        raise ConfigError(
-            f"gripper.max_width_m={node.max_width_m!r} is invalid: expected <= {hand.max_width_m:.6g} m, the "
-            f"stroke of the finger joints of {node.urdf}"
-        )
+def _check_urdf_named(node: DictConfig) -> None:
+    """The ``urdf`` gripper option without a ``gripper.urdf`` file: one line saying how to give it."""
+    if isinstance(node, DictConfig) and node.get("urdf", None) is None and node.get("name") == URDF_OPTION:
+        _missing("gripper.urdf")
 
 
 def _check_split(cfg: DictConfig) -> None:
@@ -140,9 +125,9 @@ def _check_split(cfg: DictConfig) -> None:
 
 
 def validate(cfg: DictConfig | Any) -> None:
-    """Raise :class:`ConfigError` naming the first dotted key whose value is unknown, missing or invalid.
-    A URDF gripper's file is read here, and its stroke fills an unset ``gripper.max_width_m``."""
-    _check_urdf_gripper(OmegaConf.select(cfg, "gripper", throw_on_missing=False))
+    """Raise :class:`ConfigError` naming the first dotted key whose value is unknown, missing or invalid;
+    reads no file and leaves ``cfg`` as it is (a URDF gripper may leave :data:`FROM_URDF` unset)."""
+    _check_urdf_named(OmegaConf.select(cfg, "gripper", throw_on_missing=False))
     _check_node(cfg, job.JobConfig, "")
     _check_relations(cfg)
     _check_split(cfg)

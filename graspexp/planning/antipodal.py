@@ -31,7 +31,7 @@ examined), ``best_pair`` (2,).
 
 import numpy as np
 
-from graspexp.config.gripper import GripperGeometry
+from graspexp.grippers import GripperGeometry
 from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
 from graspexp.planning.collision import frame_from_axes, place_for_request
 from graspexp.planning.friction import cone_cosine, line_cone_cosines

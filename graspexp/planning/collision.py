@@ -4,7 +4,7 @@ Shared by the ``antipodal``, ``obb``, ``random`` and ``optimal_plus`` planners. 
 
 Geometry (the same as :mod:`graspexp.sim.gripper`), in the grasp frame (+Z approach, +Y closing axis,
 origin midway between the pads), for an opening ``w``, finger span ``[z0, z1]`` along Z
-(:class:`graspexp.config.gripper.GripperGeometry`: palm face to fingertips), width ``fw`` (X),
+(:class:`graspexp.grippers.GripperGeometry`: palm face to fingertips), width ``fw`` (X),
 thickness ``t`` (Y) and palm size ``(px, py, pz)``:
 
 - left finger  ``x in [-fw/2, fw/2]``, ``y in [ w/2,  w/2 + t]``, ``z in [z0, z1]``;
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from graspexp.config import GripperConfig
-from graspexp.config.gripper import GripperGeometry
+from graspexp.grippers import GripperGeometry
 from graspexp.planning.hull_sweep import hull_cloud_hits, hull_lowest_z
 from graspexp.planning.kernels import COUNT_ALL, box_lowest_z, swept_box_hits
 from graspexp.planning.pose import slab_spans_m

@@ -1,6 +1,6 @@
 """The volume checks of :mod:`.collision` for a URDF gripper: its convex pieces, swept along the approach.
 
-A piece (:class:`graspexp.config.gripper_urdf.HandMeshes`) is a convex hull in the gripper frame (+Z
+A piece (:class:`graspexp.grippers.HandMeshes`) is a convex hull in the gripper frame (+Z
 approach, +Y closing axis, origin the TCP), a finger's at zero opening; half the opening ``w/2`` moves the
 left finger's pieces along +Y and the right finger's along -Y. The trial moves the open gripper straight
 from ``-sweep_m`` along +Z to the grasp pose, so a piece sweeps the hull of its vertices and the same
@@ -14,7 +14,7 @@ import functools
 import numpy as np
 from scipy.spatial import ConvexHull
 
-from graspexp.config.gripper_urdf import SLIDE, HandMeshes
+from graspexp.grippers.urdf import SLIDE, HandMeshes
 from graspexp.planning.kernels import COUNT_ALL, swept_hull_hits
 
 

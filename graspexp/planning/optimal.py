@@ -50,9 +50,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from graspexp.config.gripper import GripperGeometry
 from graspexp.core.geometry import make_pose
 from graspexp.core.seeding import derive_seed
+from graspexp.grippers import GripperGeometry
 from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
 from graspexp.planning.clusters import Clusters, choose_k, elongation, main_axis, max_radii_m, segment
 from graspexp.planning.collision import cloud_hits, lowest_z

@@ -57,9 +57,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from graspexp.config.gripper import GripperGeometry
 from graspexp.core.geometry import transform_points
 from graspexp.core.seeding import rng_for
+from graspexp.grippers import GripperGeometry
 from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
 from graspexp.planning.collision import Placement, cloud_hits, place_for_request
 from graspexp.planning.friction import cone_cosine

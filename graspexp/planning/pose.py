@@ -12,7 +12,7 @@ Width
 
 Section between the pads
     In the grasp frame, take the object points inside the pads' sweep: ``|x| <= finger_width/2`` and
-    ``z`` within the fingers' extent (:class:`graspexp.config.gripper.GripperGeometry`). Their span ``[y_lo, y_hi]`` along the
+    ``z`` within the fingers' extent (:class:`graspexp.grippers.GripperGeometry`). Their span ``[y_lo, y_hi]`` along the
     closing axis is the section the fingers close on (:func:`slab_spans_m`); its extent
     ``y_hi - y_lo`` is the opening it needs. The pads close symmetrically, so the planner moves the
     grasp point along Y to the section's middle, ``c_k + (y_lo + y_hi)/2 * Y`` (the paper's c_k is a
@@ -27,7 +27,7 @@ Section between the pads
 import numpy as np
 
 from graspexp.config import GripperConfig
-from graspexp.config.gripper import GripperGeometry
+from graspexp.grippers import GripperGeometry
 from graspexp.planning.kernels import grasp_frames, slab_spans
 
 PARALLEL_TOL = 1e-6

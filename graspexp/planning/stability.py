@@ -29,8 +29,8 @@ axis, origin midway between the pads; the fingers span ``[root_z_m, tip_z_m]`` a
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
-from graspexp.config.gripper import GripperGeometry
 from graspexp.core.geometry import axis_angle_matrix
+from graspexp.grippers import GripperGeometry
 from graspexp.planning.kernels import pad_contact_stats, pad_edge_excess
 
 

@@ -8,14 +8,12 @@ built by :mod:`graspexp.record.scene` (imported on its own: it needs the simulat
 """
 
 from graspexp.record.reader import (
-    TRIALS_DIR,
     CorruptLogError,
     OldLogFormatError,
     TrialLog,
     iter_trial_logs,
     read_result,
     read_trial,
-    trial_log_path,
 )
 from graspexp.record.writer import TrialRecorder, TrialWriter, trial_recorder
 
@@ -25,10 +23,8 @@ __all__ = [
     "TrialLog",
     "TrialRecorder",
     "TrialWriter",
-    "TRIALS_DIR",
     "iter_trial_logs",
     "read_result",
     "read_trial",
-    "trial_log_path",
     "trial_recorder",
 ]

@@ -30,6 +30,7 @@ from mcap.stream_reader import MAGIC_SIZE, CRCValidationError, StreamReader
 from mcap.writer import MCAP0_MAGIC
 from mcap_protobuf.decoder import DecoderFactory
 
+from graspexp.core.run_layout import trials_dir
 from graspexp.record import schemas as S
 
 _FOOTER_TAIL = 4 + MAGIC_SIZE
@@ -422,20 +423,11 @@ def _trial_sort_key(p: Path) -> tuple:
     return (p.parent.name, 0, int(stem), "") if stem.isdigit() else (p.parent.name, 1, 0, stem)
 
 
-TRIALS_DIR = "trials"
-"""The folder of a run directory that holds its trial logs, ``trials/<object>/<NNN>.mcap``."""
-
-
-def trial_log_path(run_dir: Path | str, object_name: str, trial: int) -> Path:
-    """Where trial ``trial`` of ``object_name`` is logged in ``run_dir``."""
-    return Path(run_dir) / TRIALS_DIR / object_name / f"{trial:03d}.mcap"
-
-
 def iter_trial_logs(run_dir: Path | str) -> Iterator[Path]:
     """Finished logs ``<run_dir>/trials/<object>/<index>.mcap``, by object then numeric index.
 
     ``.partial`` files (unfinished trials) are skipped.
     """
-    trials = Path(run_dir) / TRIALS_DIR
+    trials = trials_dir(run_dir)
     paths = [p for p in trials.glob("*/*.mcap") if p.is_file() and not p.name.endswith(S.PARTIAL_SUFFIX)]
     yield from sorted(paths, key=_trial_sort_key)

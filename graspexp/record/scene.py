@@ -23,9 +23,8 @@ from foxglove.messages import (
 )
 
 from graspexp.config import JobConfig
-from graspexp.config.gripper import GripperGeometry
-from graspexp.config.gripper_urdf import LEFT, PALM, RIGHT, HandMeshes
 from graspexp.core.bodies import FINGER_NAMES, OBJECT_NAME, PALM_NAME, SUPPORT_NAME
+from graspexp.grippers import LEFT, PALM, RIGHT, GripperGeometry, HandMeshes
 from graspexp.sim.collision_shapes import hull_meshes
 
 SCENE_DECIMALS = 6

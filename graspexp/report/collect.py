@@ -18,7 +18,8 @@ import yaml
 
 from graspexp.config.differences import result_config
 from graspexp.core.outcome import result_from_dict
-from graspexp.record import TRIALS_DIR, CorruptLogError, read_result
+from graspexp.core.run_layout import TRIALS_DIR, hydra_dir, results_tables, trials_dir
+from graspexp.record import CorruptLogError, read_result
 from graspexp.record.reader import read_metadata
 from graspexp.record.writer import PARTIAL_SUFFIX
 
@@ -28,7 +29,6 @@ NOISE_KEYS: tuple[str, ...] = ("trans_mm", "rot_deg")
 """The pose-noise level of a trial's run (``perception.noise``): mm and degrees."""
 TRIAL_KEYS: tuple[str, ...] = (*SETTING_KEYS, *NOISE_KEYS, "object", "trial")
 """One trial is identified by these fields."""
-RESULTS_CSV = "results.csv"
 FINGERPRINT_COLUMN = "machine"
 """Column of :func:`collect`: where a log was made (:func:`fingerprint`); empty for results.csv rows."""
 FINGERPRINT_KEYS = (
@@ -110,11 +110,11 @@ def _log_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
 def _csv_rows(root: Path) -> list[dict]:
     """Rows of every results.csv below ``root`` whose run directory holds no trial log."""
     rows = []
-    for table in sorted(root.rglob(RESULTS_CSV)):
+    for table in results_tables(root):
         run_dir = table.parent
-        if (run_dir / TRIALS_DIR).is_dir() and find_trial_logs(run_dir):
+        if trials_dir(run_dir).is_dir() and find_trial_logs(run_dir):
             continue
-        hydra_cfg = run_dir / ".hydra" / "config.yaml"
+        hydra_cfg = hydra_dir(run_dir) / "config.yaml"
         noise = noise_of(yaml.safe_load(hydra_cfg.read_text())) if hydra_cfg.is_file() else (0.0, 0.0)
         for result in pd.read_csv(table).to_dict("records"):
             timings = result.get("timings_s")

@@ -26,14 +26,11 @@ from hydra.experimental.callback import Callback
 from hydra.types import RunMode
 from omegaconf import DictConfig, OmegaConf
 
+from graspexp.core.run_layout import FAILED_DIR, SWEEP_LOCK_NAME
 from graspexp.run.locks import DirectoryLock, RunError
 
 SWEEP_ID_ENV = "GRASPEXP_SWEEP_ID"
 """Environment variable naming the running multirun (set by :class:`SweepReport`, inherited by jobs)."""
-SWEEP_LOCK_NAME = ".graspexp-sweep.lock"
-"""Lock file of a sweep directory, held by the process that launches the sweep's jobs."""
-FAILED_DIR = ".graspexp-failed"
-"""Folder under the sweep directory holding one record per failed job, per sweep id."""
 MAX_VALUE_CHARS = 32
 """An override value longer than this shows as its head plus a hash in the job directory name."""
 MAX_NAME_CHARS = 120

@@ -4,16 +4,12 @@ import os
 from pathlib import Path
 
 import numpy as np
-from omegaconf import OmegaConf
 
 from graspexp.config.errors import ConfigError
 from graspexp.config.registry import job_config_from_yaml
-from graspexp.datasets import job_object
 from graspexp.datasets.catalog import DATA_ENV
-from graspexp.planning import plan
-from graspexp.quality import fc_min_mu
-from graspexp.sim.collision_shapes import shape_with_fallback
-from graspexp.sim.trial import NullRecorder, TrialContext, run_trial
+from graspexp.run.objects import load_object, trial_context
+from graspexp.sim.trial import NullRecorder, plain_config, run_trial
 
 POSE_TOLERANCE = 1e-6
 """Largest difference allowed between a logged and a re-simulated pose component (m, or unit quaternion)."""
@@ -52,23 +48,12 @@ def resimulate(log) -> tuple[bool, str]:
         and not os.environ.get(DATA_ENV)
     ):
         cfg.dataset.root = recorded_root  # the folder the trial read its mesh from, when no other is named
-    plain = OmegaConf.to_object(cfg)
+    plain = plain_config(cfg)
     name, trial, seed = meta["object"], int(meta["trial"]), int(meta["trial_seed"])
-    model = job_object(cfg, name)
+    loaded = load_object(cfg, name, plain)
+    model, shape = loaded.model, loaded.hulls
     capture = _PoseCapture()
-    shape, _ = shape_with_fallback(model.mesh, plain.sim)
-    result = run_trial(
-        TrialContext(
-            plain,
-            model,
-            shape,
-            trial,
-            seed,
-            capture,
-            plan=plan,
-            quality=fc_min_mu,
-        )
-    )
+    result = run_trial(trial_context(plain, loaded, trial, capture, seed=seed))  # the seed the log recorded
     logged = log.result or {}
     problems = []
     recorded = meta.get("mesh_sha256")

@@ -141,7 +141,7 @@ def _run_fingerprint_job(overrides: tuple[str, ...], run_dir: str) -> str:
     from graspexp.config.compose import compose_validated
     from graspexp.run.runner import run_in_dir
 
-    cfg = compose_validated(list(overrides))
+    cfg = compose_validated(list(overrides))  # run_in_dir makes it ready
     with contextlib.redirect_stdout(io.StringIO()):
         run_in_dir(cfg, Path(run_dir))
     return str(Path(run_dir) / "results.csv")
@@ -183,7 +183,7 @@ def commit_of(root: Path) -> tuple[str, str]:
 
 def describe_machine() -> str:
     """What the machine is, in words: cores, architecture, VM or not, CPU model, the physics backend."""
-    from graspexp.run.runner import machine_fingerprint
+    from graspexp.run.provenance import machine_fingerprint
 
     cpu = machine_fingerprint()["cpu"]
     try:
@@ -287,12 +287,12 @@ def regenerate(
 
 def _fingerprint_trials(page: Page) -> int:
     """Trials of ``page``'s fingerprint: objects x trials per job, summed."""
-    from graspexp.config.compose import compose_validated
     from graspexp.datasets import select_objects
+    from graspexp.run.job_config import compose_job
 
     n = 0
     for job in fingerprint_jobs(page):
-        cfg = compose_validated(list(job))
+        cfg = compose_job(list(job))
         n += len(select_objects(cfg.dataset, cfg.objects)) * int(cfg.trials)
     return n
 

@@ -14,9 +14,10 @@ from pathlib import Path
 import pandas as pd
 from omegaconf import OmegaConf
 
-from graspexp.config.compose import compose_validated
+from graspexp.core.run_layout import results_csv
 from graspexp.report.study import SweepStudy
 from graspexp.report.tuning import ScoredSet
+from graspexp.run.job_config import compose_job
 from graspexp.run.runner import run_in_dir
 
 REPLACED_KEYS = ("objects", "dataset.objects", "dataset.split", "trials", "progress")
@@ -42,7 +43,7 @@ def score_study(
     (``trials`` per object); returns both, the baseline first. Raises
     :class:`graspexp.config.ConfigError` for a bad override."""
     base = score_overrides(sweep, split, trials, extra)
-    cfg = compose_validated(base)
+    cfg = compose_job(base)
     baseline = {k: OmegaConf.select(cfg, k) for k in sweep.searched}
     label = "paper" if not any(o.startswith("cost=") for o in base) else "baseline"
     out = []
@@ -50,10 +51,10 @@ def score_study(
     chosen = best if candidate is None else sweep.study.trials[candidate]
     tuned = "tuned" if chosen.number == best.number else f"trial {chosen.number}"
     for name, params, number in ((label, baseline, None), (tuned, dict(chosen.params), chosen.number)):
-        job = compose_validated([*base, *(f"{k}={v!r}" for k, v in params.items())])
+        job = compose_job([*base, *(f"{k}={v!r}" for k, v in params.items())])
         run_dir = sweep_dir / "score" / f"{split}_{name.replace(' ', '')}"
         t0 = time.perf_counter()
         run_in_dir(job, run_dir)
-        results = pd.read_csv(run_dir / "results.csv")
+        results = pd.read_csv(results_csv(run_dir))
         out.append(ScoredSet(name, params, results, run_dir, time.perf_counter() - t0, number))
     return out

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from graspexp.report.paper import PAPER_TABLES, SETTINGS, TRIALS_PER_SETTING
+from graspexp.run.multirun import multirun_command
 
 
 def sweep_values(key: str, values: tuple[str, ...] | list[str]) -> str:
@@ -215,25 +216,14 @@ def reading_sweep(
     given = {o.split("=", 1)[0] for o in (*reading.overrides, *overrides)}
     defaults = [
         o
-        for o in (
-            sweep_values("dataset", PAPER_DATASETS),
-            f"trials={TRIALS_PER_SETTING}",
-            "hydra/launcher=joblib",
-        )
+        for o in (sweep_values("dataset", PAPER_DATASETS), f"trials={TRIALS_PER_SETTING}")
         if o.split("=", 1)[0] not in given
     ]
-    return [
-        sys.executable,
-        "-m",
-        "graspexp",
-        "-m",
-        *SETTINGS_SWEEP,
-        *defaults,
-        "progress=false",
-        f"hydra.sweep.dir={sweep_dir if sweep_dir is not None else out / reading.name}",
-        *reading.overrides,
-        *overrides,
-    ]
+    return multirun_command(
+        sweep_dir if sweep_dir is not None else out / reading.name,
+        [*SETTINGS_SWEEP, *defaults, "progress=false", *reading.overrides, *overrides],
+        **({"launcher": ()} if "hydra/launcher" in given else {}),
+    )
 
 
 NOISE_LEVELS: tuple[tuple[float, float], ...] = ((10.0, 0.0), (20.0, 0.0), (0.0, 10.0))

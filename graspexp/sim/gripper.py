@@ -17,10 +17,10 @@ from dataclasses import dataclass, field
 import numpy as np
 import sapien
 
-from graspexp.config.gripper import GripperConfig, GripperGeometry
-from graspexp.config.gripper_urdf import LEFT, PALM, RIGHT, HandMeshes
+from graspexp.config.gripper import GripperConfig
 from graspexp.core.bodies import FINGER_NAMES, PALM_NAME
 from graspexp.core.geometry import matrix_to_quat_wxyz
+from graspexp.grippers import LEFT, PALM, RIGHT, GripperGeometry, HandMeshes
 from graspexp.sim.scene import GRIPPER_BIT, OBJECT_BIT, SUPPORT_BIT, set_groups
 
 # wxyz quaternions that turn a joint's +x axis onto the named axis
@@ -92,7 +92,7 @@ def _attach_hulls(
     entities: list[sapien.Entity], hand: HandMeshes, material: sapien.physx.PhysxMaterial
 ) -> None:
     """Give the palm and finger links (entities not yet in a scene) the convex pieces of a URDF gripper, each
-    in its link's frame (:mod:`graspexp.config.gripper_urdf`)."""
+    in its link's frame (:mod:`graspexp.grippers.urdf`)."""
     links = {e.name: e.find_component_by_type(sapien.physx.PhysxArticulationLinkComponent) for e in entities}
     names = {PALM: PALM_NAME, LEFT: FINGER_NAMES[0], RIGHT: FINGER_NAMES[1]}
     one = np.ones(3, dtype=np.float32)

@@ -48,7 +48,8 @@ from omegaconf import OmegaConf
 
 from graspexp.config import ConfigError, PluginError
 from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
-from graspexp.report.collect import RESULTS_CSV, collect
+from graspexp.core.run_layout import results_csv
+from graspexp.report.collect import collect
 from graspexp.report.compare import FC_MU, check_same_drops, render_markdown
 from graspexp.report.compare import success_by_noise as noise_success_table
 from graspexp.report.contact_area import IN_AREA_TOLERANCE_M, finger_contacts_in_area
@@ -56,6 +57,7 @@ from graspexp.report.paper import PAPER_TABLES, SETTINGS, TRIALS_PER_SETTING
 from graspexp.report.render import display_frame, footnotes, markdown
 from graspexp.report.stats import percentiles, success_pct
 from graspexp.report.tables import failure_breakdown, success_table
+from graspexp.run.multirun import multirun_command
 from graspexp.run.suites import NOISE_LEVELS, PAPER_MODES, PAPER_ROTS, Job, benchmark_suite
 from graspexp.tools.cli import compose_checked, fail, positive_int, tool_parser
 
@@ -216,21 +218,17 @@ def sweep_command(bench: Benchmark, planner_jobs: list[Job]) -> list[str]:
         launcher += [f"hydra.launcher.partition={bench.slurm_partition}"] if bench.slurm_partition else []
     else:
         launcher = ["hydra/launcher=joblib", f"hydra.launcher.n_jobs={bench.n_jobs}"]
-    return [
-        sys.executable,
-        "-m",
-        "graspexp",
-        "-m",
+    overrides = [
         f"planner={first.planner}",
         f"dataset={','.join(dict.fromkeys(j.dataset for j in planner_jobs))}",
         f"mode={','.join(dict.fromkeys(j.mode for j in planner_jobs))}",
         f"rot={','.join(dict.fromkeys(j.rot for j in planner_jobs))}",
         f"perception.noise={noise}",
         *rest,
-        f"hydra.sweep.dir={Path(bench.out) / first.planner / 'runs'}",
         f"hydra.sweep.subdir='{RUN_SUBDIR}'",  # quoted: Hydra resolves it per job
-        *launcher,
+        *launcher,  # last: the benchmark's launcher keys win over any in the job overrides
     ]
+    return multirun_command(Path(bench.out) / first.planner / "runs", overrides, launcher=())
 
 
 def run_all(bench: Benchmark, todo: list[Job]) -> list[str]:
@@ -243,7 +241,7 @@ def run_all(bench: Benchmark, todo: list[Job]) -> list[str]:
     for planner_jobs in by_planner.values():
         rc = subprocess.call(sweep_command(bench, planner_jobs))
         for job in planner_jobs:
-            if not (Path(job.run_dir) / RESULTS_CSV).is_file():
+            if not results_csv(job.run_dir).is_file():
                 errors.append(f"{job.run_dir}: no results (the sweep of {job.planner} exited {rc})")
     return errors
 
@@ -319,7 +317,7 @@ def ranking(df: pd.DataFrame, dataset: str, settings: list[str]) -> pd.DataFrame
 def reproduce_record(bench: Benchmark, all_jobs: list[Job], configs: list[dict], argv: list[str]) -> dict:
     """Everything needed to re-run the suite: command, benchmark keys, each job's composed config
     (``configs``, in job order), package versions, and each planner's package, entry point and version."""
-    from graspexp.run.runner import package_versions
+    from graspexp.run.provenance import package_versions
 
     planners = {}
     for name in dict.fromkeys(j.planner for j in all_jobs):

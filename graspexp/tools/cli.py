@@ -2,8 +2,8 @@
 
 - ``--option``: the tool's own options, parsed by :mod:`argparse` from :func:`tool_parser` (``-h`` /
   ``--help`` says ``graspexp <tool>``; a bad option is ``usage`` plus one error line, exit status 2).
-- ``key=value``: Hydra overrides of the job config (``graspexp/conf/config.yaml``), for the tools that take
-  one. They are composed by :func:`graspexp.config.compose.compose_validated`, the one place that composes
+- ``key=value``: Hydra overrides of the job config (``conf/config.yaml``), for the tools that take
+  one. They are composed by :func:`graspexp.run.job_config.compose_job`, the one place that composes
   outside a Hydra run, which raises :class:`~graspexp.config.ConfigError`; :func:`compose_checked` turns it
   into one ``graspexp <tool>: error:`` line and exit status 2.
 
@@ -21,8 +21,9 @@ from collections.abc import Callable, Sequence
 from omegaconf import DictConfig
 
 from graspexp.config import ConfigError
-from graspexp.config.compose import compose_validated, expand_sweeps, one_line, search_ranges
+from graspexp.config.compose import expand_sweeps, one_line, search_ranges
 from graspexp.config.registry import group_options
+from graspexp.run.job_config import compose_job
 from graspexp.run.launchers import submitit_guard
 from graspexp.tools import TOOLS
 
@@ -73,7 +74,7 @@ def tool_parser(prog: str, description: str, overrides: bool = False) -> argpars
 def compose_checked(overrides: Sequence[str], prog: str = "graspexp") -> DictConfig:
     """The validated job config of ``overrides``; a bad override exits with ``<prog>: error:`` (status 2)."""
     try:
-        return compose_validated(overrides)
+        return compose_job(overrides)
     except ConfigError as exc:
         fail(str(exc), prog)
         raise  # unreachable: fail exits

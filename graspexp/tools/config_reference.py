@@ -2,7 +2,7 @@
 
 Every key of every config group (and of every installed planner) with its type, unit, default, allowed
 values and docstring, read from the structured-config schemas (``graspexp/config/``), their
-``CONSTRAINTS`` and the YAML options (``graspexp/conf/``), so the reference cannot drift from the code.
+``CONSTRAINTS`` and the YAML options (``conf/``), so the reference cannot drift from the code.
 The documentation site builds its page ``reference/configuration.md`` from :func:`render` (``docs/hooks.py``).
 """
 
@@ -212,7 +212,7 @@ def render() -> str:
         "# Configuration reference",
         "",
         "Generated from the schemas (`graspexp/config/`), their `CONSTRAINTS` and the YAML options "
-        "(`graspexp/conf/`) by `python -m graspexp config_reference` each time the site is built: do not "
+        "(`conf/`) by `python -m graspexp config_reference` each time the site is built: do not "
         "edit it by hand, edit the field's docstring. Override any key as `python -m graspexp KEY=VALUE`; "
         "pick an option as `GROUP=OPTION`. *allowed* is what validation accepts (a value outside it is one "
         "`graspexp: error:` line).",

@@ -32,8 +32,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from graspexp.config.gripper import GripperGeometry  # noqa: E402
 from graspexp.datasets import DatasetError, available_objects, job_object  # noqa: E402
+from graspexp.grippers import GripperGeometry  # noqa: E402
 from graspexp.planning import NoFeasibleGrasp, UnknownPlanner  # noqa: E402
 from graspexp.run.upright import PlannedObject, plan_upright  # noqa: E402
 from graspexp.tools.cli import compose_checked, fail, tool_parser  # noqa: E402

@@ -61,7 +61,7 @@ def main(argv: list[str] | None = None) -> int:
     from graspexp.datasets import DatasetError
     from graspexp.report.study import plot_study
     from graspexp.report.tuning import tuning_markdown
-    from graspexp.run.runner import RunError
+    from graspexp.run.locks import RunError
     from graspexp.run.score import score_study
 
     try:

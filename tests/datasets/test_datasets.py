@@ -121,7 +121,7 @@ def test_meshes_are_cached_and_handed_out_as_copies(data_root):
 
 
 def test_dictconfig_from_the_yaml_option_works(data_root):
-    option = yaml.safe_load((REPO / "graspexp/conf/dataset/linemod.yaml").read_text())
+    option = yaml.safe_load((REPO / "conf/dataset/linemod.yaml").read_text())
     option.pop("defaults")  # Hydra's defaults list; the schema itself is what it names
     cfg = OmegaConf.merge(OmegaConf.structured(DatasetConfig), option, {"root": str(data_root)})
     assert dataset_objects(cfg) == list(DATASETS["linemod"].default_objects)
@@ -144,7 +144,7 @@ def test_dictconfig_from_the_yaml_option_works(data_root):
 
 @pytest.mark.parametrize("name", sorted(DATASETS))
 def test_conf_options_take_the_object_list_from_the_catalogue(name):
-    conf = yaml.safe_load((REPO / f"graspexp/conf/dataset/{name}.yaml").read_text())
+    conf = yaml.safe_load((REPO / f"conf/dataset/{name}.yaml").read_text())
     assert "objects" not in conf  # the default list is written once, in DATASETS
     assert conf["regions"] == f"{name}.yaml"
     assert set(DATASETS[name].default_objects) <= set(DATASETS[name].catalogue)

@@ -8,8 +8,8 @@ from omegaconf import OmegaConf
 from test_planner_common import RG2  # explicit RG2 dimensions, independent of conf/gripper
 
 from graspexp.config.compose import compose_config
-from graspexp.config.gripper import GripperGeometry
 from graspexp.config.plugins import LoadedPlanner, load_planners
+from graspexp.grippers import GripperGeometry
 from graspexp.planning import Grasp, NoFeasibleGrasp, PlanRequest, get_planner, plan
 from graspexp.planning.antipodal import antipodal_pairs
 from graspexp.planning.collision import cloud_hits, frame_from_axes, lowest_z

@@ -8,8 +8,8 @@ import pytest
 import trimesh
 from test_baselines import TABLE_Z, _cfg, _cloud
 
-from graspexp.config.gripper import GripperGeometry
 from graspexp.core.geometry import make_pose, random_rotation
+from graspexp.grippers import GripperGeometry
 from graspexp.planning import NoFeasibleGrasp, PlanRequest, plan
 from graspexp.planning.stability import (
     gravity_arm_m,

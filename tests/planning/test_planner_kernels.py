@@ -12,8 +12,8 @@ from test_planner_common import RG2, UPRIGHT_SUPPORT_Z, upright_request
 
 import graspexp.planning.optimal as optimal
 from graspexp.config import CostConfig, DatasetConfig, OptimalConfig
-from graspexp.config.gripper import GripperGeometry
 from graspexp.datasets import available_objects, load_object
+from graspexp.grippers import GripperGeometry
 from graspexp.planning import NoFeasibleGrasp, PlanRequest, plan
 from graspexp.planning.clusters import KMEANS_MAX_ITER, KMEANS_TOL, Clusters, max_radii_m, segment
 from graspexp.planning.collision import cloud_hits

@@ -7,18 +7,18 @@ import trimesh
 from conftest import compose_cfg, write_urdf_gripper
 from omegaconf import OmegaConf
 
-from graspexp.config import validate
-from graspexp.config.gripper import GripperGeometry
 from graspexp.config.plugins import LoadedPlanner, load_planners
+from graspexp.grippers import GripperGeometry
 from graspexp.planning import PlanRequest, plan
 from graspexp.planning.collision import cloud_hits, frame_from_axes, lowest_z
+from graspexp.run.job_config import make_ready
 
 PLANNERS = tuple(sorted(n for n, p in load_planners().items() if isinstance(p, LoadedPlanner)))
 
 
 def _gripper(*overrides: str):
     cfg = compose_cfg(*overrides)
-    validate(cfg)
+    make_ready(cfg)
     return OmegaConf.to_object(cfg).gripper
 
 
@@ -64,7 +64,7 @@ def test_every_planner_plans_with_a_urdf_gripper(tmp_path, planner):
     cfg = compose_cfg(
         f"planner={planner}", "mode=bin", "gripper=urdf", f"gripper.urdf={write_urdf_gripper(tmp_path)}"
     )
-    validate(cfg)
+    make_ready(cfg)
     cfg = OmegaConf.to_object(cfg)
     mesh = trimesh.creation.box(extents=[0.05, 0.04, 0.12])
     pts, faces = trimesh.sample.sample_surface_even(mesh, 768, seed=0)

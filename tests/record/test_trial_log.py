@@ -9,14 +9,9 @@ import pytest
 from conftest import compose_cfg, strictly_valid
 from mcap.reader import make_reader
 
-from graspexp.core.seeding import trial_seed
-from graspexp.datasets import job_object
-from graspexp.planning import plan
-from graspexp.quality import fc_min_mu
 from graspexp.record import TrialRecorder, read_trial
-from graspexp.record.scene import object_scene
-from graspexp.sim.collision_shapes import collision_shape
-from graspexp.sim.trial import TrialContext, plain_config, run_trial
+from graspexp.run.objects import load_object, trial_context
+from graspexp.sim.trial import plain_config, run_trial
 
 pytestmark = [pytest.mark.sim, pytest.mark.slow]
 REPO = Path(__file__).resolve().parents[2]
@@ -124,24 +119,12 @@ def test_bin_logs_valid_for_independent_readers(two_runs):
 @pytest.fixture(scope="module")
 def collab_log(tmp_path_factory) -> Path:
     """One collab trial that grasps and then removes the support, logged in-process."""
-    plain = plain_config(compose_cfg("mode=collab"))
-    name = "can"
-    model = job_object(plain, name)
-    hulls = collision_shape(model.mesh, plain.sim)
+    cfg = compose_cfg("mode=collab")
+    plain = plain_config(cfg)
+    loaded = load_object(cfg, "can", plain)
     path = tmp_path_factory.mktemp("collab") / "000.mcap"
-    with TrialRecorder(path, {"object": name}) as rec:
-        ctx = TrialContext(
-            plain,
-            model,
-            hulls,
-            0,
-            trial_seed(plain, name, 0),
-            rec,
-            object_scene(plain, hulls),
-            plan=plan,
-            quality=fc_min_mu,
-        )
-        run_trial(ctx)
+    with TrialRecorder(path, {"object": "can"}) as rec:
+        run_trial(trial_context(plain, loaded, 0, rec))
     return path
 
 

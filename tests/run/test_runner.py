@@ -21,7 +21,10 @@ from graspexp.config.differences import config_differences
 from graspexp.core.outcome import FailureReason, TrialResult
 from graspexp.datasets import DatasetError
 from graspexp.record import TrialRecorder, read_result
-from graspexp.run.runner import job_lock, job_metadata, run_in_dir, summarize
+from graspexp.run.provenance import job_metadata
+from graspexp.run.resume import job_lock
+from graspexp.run.runner import run_in_dir
+from graspexp.run.summary import summarize
 
 REPO = Path(__file__).resolve().parents[2]
 BASE = ("objects=[can]", "trials=1")

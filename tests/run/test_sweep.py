@@ -172,7 +172,7 @@ def test_job_dir_name_is_readable_short_and_unique() -> None:
 
 @pytest.mark.slow
 def test_a_second_sweep_into_a_running_sweeps_directory_is_refused_before_any_job(tmp_path: Path) -> None:
-    from graspexp.run.jobs import SWEEP_LOCK_NAME
+    from graspexp.core.run_layout import SWEEP_LOCK_NAME
     from graspexp.run.locks import DirectoryLock
 
     sweep = tmp_path / "sweep"

@@ -9,10 +9,9 @@ import sapien
 from conftest import compose_cfg, write_urdf_gripper
 from omegaconf import OmegaConf
 
-from graspexp.config import validate
-from graspexp.config.compose import compose_validated
 from graspexp.config.registry import group_options
 from graspexp.core.bodies import OBJECT_NAME
+from graspexp.run.job_config import compose_job, make_ready
 from graspexp.sim.contacts import finger_forces
 from graspexp.sim.gripper import build_gripper
 from graspexp.sim.scene import GRIPPER_BIT, OBJECT_BIT, configure_physx, set_groups
@@ -36,7 +35,7 @@ def steady_finger_forces(overrides: list[str], width_m: float) -> tuple[np.ndarr
     """((2,) mean force of each finger on a static box of ``width_m`` along the closing axis, N; grip_force_n)
     for the gripper of ``overrides``."""
     composed = compose_cfg(*overrides)
-    validate(composed)
+    make_ready(composed)
     cfg = OmegaConf.to_object(composed)
     configure_physx(cfg.sim)
     scene = sapien.Scene([sapien.physx.PhysxCpuSystem()])
@@ -60,6 +59,6 @@ def steady_finger_forces(overrides: list[str], width_m: float) -> tuple[np.ndarr
 @pytest.mark.parametrize("wide", [False, True], ids=["thin", "wide"])
 def test_steady_finger_force_is_the_configured_grip_force(gripper: str, wide: bool, tmp_path: Path) -> None:
     overrides = gripper_overrides(gripper, tmp_path)
-    stroke = compose_validated(overrides).gripper.max_width_m
+    stroke = compose_job(overrides).gripper.max_width_m
     forces, grip_force = steady_finger_forces(overrides, WIDE_FRACTION * stroke if wide else THIN_M)
     np.testing.assert_allclose(forces, grip_force, rtol=0.05)

@@ -7,15 +7,12 @@ from conftest import compose_cfg
 from graspexp.core.bodies import SUPPORT_NAME
 from graspexp.core.geometry import make_pose, quat_wxyz_to_matrix
 from graspexp.core.outcome import FailureReason
-from graspexp.core.seeding import trial_seed
-from graspexp.datasets import job_object
 from graspexp.planning import plan
 from graspexp.planning.grasp import Grasp
 from graspexp.planning.request import PlanResult
-from graspexp.quality import fc_min_mu
-from graspexp.sim.collision_shapes import collision_shape
+from graspexp.run.objects import load_object, trial_context
 from graspexp.sim.contacts import GRIPPER_LINKS
-from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
+from graspexp.sim.trial import NullRecorder, plain_config, run_trial
 
 pytestmark = pytest.mark.sim
 
@@ -38,12 +35,7 @@ class ContactCapture(NullRecorder):
 def _ctx(*overrides, obj="can", trial=0, recorder=None, planner=plan):
     cfg = compose_cfg("dataset=primitives", *overrides)
     plain = plain_config(cfg)
-    model = job_object(cfg, obj)
-    hulls = collision_shape(model.mesh, plain.sim)
-    seed = trial_seed(plain, obj, trial)
-    return TrialContext(
-        plain, model, hulls, trial, seed, recorder or NullRecorder(), plan=planner, quality=fc_min_mu
-    )
+    return trial_context(plain, load_object(cfg, obj, plain), trial, recorder, plan=planner)
 
 
 # golden trials: fixed seeds whose drops the planner grasps (other seeds may fail for honest reasons)
@@ -145,8 +137,7 @@ def test_a_rocking_object_is_settled_only_after_settle_hold_s(hold_s, rests, dat
         "dataset=ycb", f"dataset.root={data_root}", "mode=bin", "rot=xyz", f"sim.settle_hold_s={hold_s}"
     )
     plain = plain_config(cfg)
-    obj = "021_bleach_cleanser"
-    model = job_object(cfg, obj)
+    loaded = load_object(cfg, "021_bleach_cleanser", plain)
     seen = {}
 
     def away(req):
@@ -155,10 +146,7 @@ def test_a_rocking_object_is_settled_only_after_settle_hold_s(hold_s, rests, dat
         return PlanResult(Grasp(pose, 0.05, 0.0, 0, 0, 1, "away"))
 
     track = ObjectTrack()
-    shape = collision_shape(model.mesh, plain.sim)
-    seed = trial_seed(plain, obj, 6)
-    ctx = TrialContext(plain, model, shape, 6, seed, track, plan=away, quality=fc_min_mu)
-    res = run_trial(ctx)
+    res = run_trial(trial_context(plain, loaded, 6, track, plan=away))
     assert res.reason == FailureReason.NO_CONTACT.value
     moved_m = np.linalg.norm(track.positions[-1] - seen["pose"][:3, 3])
     assert (moved_m < 0.001) == rests, moved_m

@@ -9,14 +9,10 @@ from conftest import compose_cfg, write_urdf_gripper
 from omegaconf import OmegaConf
 from test_grip_force import THIN_M, steady_finger_forces
 
-from graspexp.config import validate
-from graspexp.core.seeding import trial_seed
-from graspexp.datasets import job_object
-from graspexp.planning import plan
-from graspexp.quality import fc_min_mu
-from graspexp.sim.collision_shapes import collision_shape
+from graspexp.run.job_config import make_ready
+from graspexp.run.objects import load_object, trial_context
 from graspexp.sim.gripper import build_gripper
-from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
+from graspexp.sim.trial import plain_config, run_trial
 
 pytestmark = pytest.mark.sim
 
@@ -28,7 +24,7 @@ def urdf(tmp_path):
 
 def test_the_links_carry_the_urdf_pieces(urdf):
     cfg = compose_cfg("gripper=urdf", urdf)
-    validate(cfg)
+    make_ready(cfg)
     gripper_cfg = OmegaConf.to_object(cfg).gripper
     scene = sapien.Scene([sapien.physx.PhysxCpuSystem()])
     grip = build_gripper(scene, gripper_cfg, np.eye(4), support_collides=False)
@@ -46,20 +42,9 @@ def test_grip_force_is_the_configured_one_within_1_percent(urdf, width_m):
 @pytest.mark.parametrize(("mode", "rot", "trial"), [("collab", "z", 0), ("bin", "xyz", 0)])
 def test_a_can_is_grasped_and_held(urdf, mode, rot, trial):
     cfg = compose_cfg("dataset=primitives", "gripper=urdf", urdf, f"mode={mode}", f"rot={rot}")
-    validate(cfg)
+    make_ready(cfg)
     plain = plain_config(cfg)
-    model = job_object(cfg, "can")
-    ctx = TrialContext(
-        plain,
-        model,
-        collision_shape(model.mesh, plain.sim),
-        trial,
-        trial_seed(plain, "can", trial),
-        NullRecorder(),
-        plan=plan,
-        quality=fc_min_mu,
-    )
-    res = run_trial(ctx)
+    res = run_trial(trial_context(plain, load_object(cfg, "can", plain), trial))
     assert res.success, res
     assert (
         min(res.finger_force_n) > 0.9 * plain.gripper.grip_force_n

@@ -29,15 +29,13 @@ from omegaconf import OmegaConf
 from threadpoolctl import threadpool_limits
 
 from graspexp.config.compose import compose_config
-from graspexp.core.seeding import trial_seed
 from graspexp.datasets import job_object
-from graspexp.planning import plan
-from graspexp.quality import fc_min_mu
+from graspexp.run.objects import LoadedObject, trial_context
 from graspexp.run.prepare import staged_objects
 from graspexp.sim.collision_accuracy import shape_accuracy, surface_points, uncovered_m
 from graspexp.sim.collision_shapes import collision_shape
 from graspexp.sim.scene import build_scene
-from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
+from graspexp.sim.trial import plain_config, run_trial
 from graspexp.tools.cli import take_sweep, tool_parser
 
 REST_STEPS = 600
@@ -76,19 +74,9 @@ def measure(overrides: list[str], dataset: str, name: str, trials: int, samples:
         gap_p90 = float(np.percentile(uncovered_m(mesh_pts, shape), 90)) * 1e3
         cook, rest = _rest_scene(shape, model.mesh, model.mass_kg, plain)
         per_step, ok = [], 0
+        loaded = LoadedObject(model, shape, None, ())  # the shape just built in the empty cache
         for i in range(trials):
-            res = run_trial(
-                TrialContext(
-                    plain,
-                    model,
-                    shape,
-                    i,
-                    trial_seed(plain, name, i),
-                    NullRecorder(),
-                    plan=plan,
-                    quality=fc_min_mu,
-                )
-            )
+            res = run_trial(trial_context(plain, loaded, i))
             ok += res.success
             if res.steps:
                 per_step.append(res.timings_s["physics"] / res.steps * 1e6)

@@ -14,7 +14,6 @@ system, workers included) and trials/s.
 import csv
 import resource
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -22,6 +21,7 @@ from pathlib import Path
 from omegaconf import OmegaConf
 
 from graspexp.datasets import select_objects
+from graspexp.run.multirun import multirun_command
 from graspexp.run.prepare import prepare_shapes
 from graspexp.run.suites import paper_suite
 from graspexp.tools.cli import compose_checked, take_sweep, tool_parser
@@ -64,8 +64,7 @@ def run_sweep(sweep: list[str], workers: int) -> dict[str, float]:
     """Run ``sweep`` with ``workers`` joblib workers into a temporary directory; wall s, CPU s (the sweep's
     processes, children included), trials. Raises RuntimeError (with the output's tail) if it fails."""
     with tempfile.TemporaryDirectory(prefix="graspexp-reproduce-") as out:
-        cmd = [sys.executable, "-m", "graspexp", "-m", *sweep, "hydra/launcher=joblib"]
-        cmd += [f"hydra.launcher.n_jobs={workers}", f"hydra.sweep.dir={out}/sweep"]
+        cmd = multirun_command(f"{out}/sweep", [*sweep, f"hydra.launcher.n_jobs={workers}"])
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
         proc = subprocess.run(cmd, capture_output=True, text=True)

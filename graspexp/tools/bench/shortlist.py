@@ -27,15 +27,13 @@ import pandas as pd
 from threadpoolctl import threadpool_limits
 
 from graspexp.config.compose import compose_config
-from graspexp.core.seeding import trial_seed
-from graspexp.datasets import available_objects, job_object
+from graspexp.datasets import available_objects
 from graspexp.planning import plan
 from graspexp.planning.optimal_plus import pick_shortlisted
 from graspexp.planning.request import PlanResult
-from graspexp.quality import fc_min_mu
+from graspexp.run.objects import load_object, trial_context
 from graspexp.run.suites import PAPER_DATASETS, PAPER_MODES, PAPER_ROTS
-from graspexp.sim.collision_shapes import collision_shape
-from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
+from graspexp.sim.trial import plain_config, run_trial
 from graspexp.tools.cli import compose_checked, fail, positive_int, take_sweep, tool_parser
 
 PROG = "graspexp bench.shortlist"
@@ -66,18 +64,13 @@ def _job(args: tuple[list[str], str, int]) -> list[dict]:
     threadpool_limits(limits=1)
     cfg = compose_config(overrides)
     plain = plain_config(cfg)
-    model = job_object(cfg, name)
-    hulls = collision_shape(model.mesh, plain.sim)
+    loaded = load_object(cfg, name, plain)
     rows = []
     for i in range(trials):
-        seed = trial_seed(plain, name, i)
         seen: dict = {}
         j, n = 0, 1
         while j < n:
-            ctx = TrialContext(
-                plain, model, hulls, i, seed, NullRecorder(), plan=_forced(j, seen), quality=fc_min_mu
-            )
-            res = run_trial(ctx)
+            res = run_trial(trial_context(plain, loaded, i, plan=_forced(j, seen)))
             if "plan" not in seen:  # no grasp planned for this drop: nothing to compare
                 break
             d = seen["plan"].details

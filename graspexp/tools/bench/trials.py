@@ -23,15 +23,11 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from graspexp.config.compose import compose_config
-from graspexp.core.seeding import trial_seed
-from graspexp.datasets import available_objects, job_object
-from graspexp.planning import plan
-from graspexp.quality import fc_min_mu
+from graspexp.datasets import available_objects
 from graspexp.record import TrialRecorder
-from graspexp.record.scene import object_scene
+from graspexp.run.objects import load_object, trial_context
 from graspexp.run.suites import PAPER_MODES
-from graspexp.sim.collision_shapes import collision_shape
-from graspexp.sim.trial import NullRecorder, TrialContext, plain_config, run_trial
+from graspexp.sim.trial import plain_config, run_trial
 from graspexp.tools.cli import compose_checked, take_sweep, tool_parser
 
 PHASES = ("build", "settle", "plan", "quality", "execute", "log")
@@ -65,36 +61,17 @@ class _Object:
         cfg = compose_config(overrides)
         self.plain = plain_config(cfg)
         self.name = name
-        self.model = job_object(cfg, name)
-        self.hulls = collision_shape(self.model.mesh, self.plain.sim)
-        self.scene = object_scene(self.plain, self.hulls)
+        self.loaded = load_object(cfg, name, self.plain)
 
     def trial(self, i: int, out: str | None) -> dict:
         """Trial ``i``, logged into folder ``out`` (None: unlogged); wall and CPU time with the timings."""
-        seed = trial_seed(self.plain, self.name, i)
         t0, c0 = time.perf_counter(), time.thread_time()
         if out is None:
-            res = run_trial(
-                TrialContext(
-                    self.plain, self.model, self.hulls, i, seed, NullRecorder(), plan=plan, quality=fc_min_mu
-                )
-            )
+            res = run_trial(trial_context(self.plain, self.loaded, i))
         else:
             path = Path(out) / self.name / f"{i:03d}.mcap"
             with _TimedRecorder(path, {"object": self.name}) as rec:
-                res = run_trial(
-                    TrialContext(
-                        self.plain,
-                        self.model,
-                        self.hulls,
-                        i,
-                        seed,
-                        rec,
-                        self.scene,
-                        plan=plan,
-                        quality=fc_min_mu,
-                    )
-                )
+                res = run_trial(trial_context(self.plain, self.loaded, i, rec))
             spent = rec.spent
         wall, cpu = time.perf_counter() - t0, time.thread_time() - c0
         ticks = {} if out is None else {f"tick_{k}": v for k, v in spent.items()}

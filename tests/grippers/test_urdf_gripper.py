@@ -1,27 +1,29 @@
 """gripper=urdf: the stroke and palm come from the file; a missing, broken or unsuitable URDF is refused in
 one line naming the key and the file."""
 
+import builtins
+import io
 import re
 
 import pytest
 from conftest import compose_cfg, write_urdf_gripper
+from omegaconf import OmegaConf
 
 from graspexp.config import ConfigError, validate
-from graspexp.config.compose import compose_validated
-from graspexp.config.gripper import GripperGeometry
-from graspexp.config.gripper_urdf import LEFT
+from graspexp.grippers import LEFT, GripperGeometry, fill_gripper
+from graspexp.run.job_config import compose_job, make_ready
 
 
 def test_the_stroke_comes_from_the_joint_limits(tmp_path):
     urdf = write_urdf_gripper(tmp_path, upper_m=0.04)
-    cfg = compose_validated(["gripper=urdf", f"gripper.urdf={urdf}"])
+    cfg = compose_job(["gripper=urdf", f"gripper.urdf={urdf}"])
     assert cfg.gripper.max_width_m == pytest.approx(0.08)
     assert list(cfg.gripper.palm_size_m) == pytest.approx([0.045, 0.15, 0.06])
 
 
 def _error(*overrides: str) -> str:
     with pytest.raises(ConfigError) as info:
-        validate(compose_cfg(*overrides))
+        make_ready(compose_cfg(*overrides))
     message = str(info.value)
     assert "\n" not in message
     return message
@@ -63,9 +65,27 @@ def test_finger_joints_must_be_prismatic_and_opposed(tmp_path):
 
 def test_the_tcp_is_behind_the_tips_or_where_the_config_puts_it(tmp_path):
     urdf = f"gripper.urdf={write_urdf_gripper(tmp_path, curved_tip=False)}"
-    default = GripperGeometry.of(compose_validated(["gripper=urdf", urdf]).gripper)
+    default = GripperGeometry.of(compose_job(["gripper=urdf", urdf]).gripper)
     assert (default.root_z_m, default.tip_z_m) == pytest.approx((-0.07, 0.01))  # as the RG2 box model
-    deeper = compose_validated(["gripper=urdf", urdf, "gripper.urdf_tcp_m=[0,0.003,0.065]"]).gripper
+    deeper = compose_job(["gripper=urdf", urdf, "gripper.urdf_tcp_m=[0,0.003,0.065]"]).gripper
     geometry = GripperGeometry.of(deeper)  # fingers from z = 0 to 0.08 in the palm link: tips 15 mm ahead
     assert (geometry.root_z_m, geometry.tip_z_m) == pytest.approx((-0.065, 0.015))
     assert geometry.hand.part_vertices(LEFT)[:, 1].min() == pytest.approx(0.0)  # y ignored: pads centred
+
+
+def test_validation_reads_no_file_and_writes_nothing_the_grippers_stage_fills_in(tmp_path, monkeypatch):
+    cfg = compose_cfg("gripper=urdf", f"gripper.urdf={write_urdf_gripper(tmp_path, upper_m=0.04)}")
+    before = OmegaConf.to_yaml(cfg)
+
+    def no_file(*args, **kwargs):
+        raise AssertionError(f"validate opened a file: {args[:1]}")
+
+    with monkeypatch.context() as m:
+        m.setattr(builtins, "open", no_file)
+        m.setattr(io, "open", no_file)
+        validate(cfg)
+    assert OmegaConf.to_yaml(cfg) == before
+    assert OmegaConf.is_missing(cfg.gripper, "max_width_m")
+    fill_gripper(cfg)
+    assert cfg.gripper.max_width_m == pytest.approx(0.08)
+    assert list(cfg.gripper.palm_size_m) == pytest.approx([0.045, 0.15, 0.06])

@@ -116,7 +116,7 @@ def _mesh_path(filename: str, urdf: Path) -> Path:
 def _geometry(element: ET.Element, urdf: Path, where: str, sources: list[Path]):
     """The trimesh.Trimesh of a ``<geometry>`` element, its own frame, metres; a mesh file read is appended
     to ``sources``."""
-    import trimesh  # here, not at the top: only a URDF gripper needs it, and the config stage loads fast
+    import trimesh  # here, not at the top: only a URDF gripper needs it, and the box models load fast
 
     shape = next(iter(element), None)
     if shape is None:

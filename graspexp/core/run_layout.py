@@ -1,0 +1,68 @@
+"""The names inside a job's run directory (Hydra's output dir) and a sweep directory: their one home.
+
+Run directory::
+
+    trials/<object>/<NNN>.mcap               one log per trial (the source of truth)
+    trials/.quarantine/<object>/<name>.<UTC>  files resume moved aside (never deleted)
+    results.csv                              one row per trial (a cache rebuilt from the logs at the end)
+    summary.md                               the per-object success table printed at the end
+    .hydra/{config,hydra,overrides}.yaml     Hydra's record of the accepted run
+    .graspexp.lock, .graspexp.lock.holder    the job's lock and who holds it
+
+A sweep directory holds one run directory per job, its lock ``.graspexp-sweep.lock`` and
+``.graspexp-failed/`` (one record per failed job).
+"""
+
+from pathlib import Path
+
+TRIALS_DIR = "trials"
+"""The folder of a run directory that holds its trial logs, ``trials/<object>/<NNN>.mcap``."""
+QUARANTINE_DIR = ".quarantine"
+"""Folder of ``trials/`` where resume moves files that are not usable trial logs (never deleted)."""
+RESULTS_CSV = "results.csv"
+"""One row per trial of the run (:meth:`graspexp.core.outcome.TrialResult.to_dict`)."""
+SUMMARY_MD = "summary.md"
+"""The run's per-object success table (markdown)."""
+HYDRA_DIR = ".hydra"
+"""Hydra's record of an accepted run: ``config.yaml``, ``hydra.yaml``, ``overrides.yaml``."""
+LOCK_NAME = ".graspexp.lock"
+"""Lock file of a run directory (held while a job writes into it)."""
+SWEEP_LOCK_NAME = ".graspexp-sweep.lock"
+"""Lock file of a sweep directory, held by the process that launches the sweep's jobs."""
+FAILED_DIR = ".graspexp-failed"
+"""Folder of a sweep directory holding one record per failed job, per sweep id."""
+
+
+def trials_dir(run_dir: Path | str) -> Path:
+    """The folder of the run's trial logs."""
+    return Path(run_dir) / TRIALS_DIR
+
+
+def trial_log_path(run_dir: Path | str, object_name: str, trial: int) -> Path:
+    """Where trial ``trial`` of ``object_name`` is logged in ``run_dir``."""
+    return trials_dir(run_dir) / object_name / f"{trial:03d}.mcap"
+
+
+def quarantine_path(run_dir: Path | str, log: Path, stamp: str) -> Path:
+    """Where resume moves the file ``log`` of ``trials/<object>/`` (``stamp``: a UTC time)."""
+    return trials_dir(run_dir) / QUARANTINE_DIR / log.parent.name / f"{log.name}.{stamp}"
+
+
+def results_csv(run_dir: Path | str) -> Path:
+    """The run's results table."""
+    return Path(run_dir) / RESULTS_CSV
+
+
+def summary_md(run_dir: Path | str) -> Path:
+    """The run's summary table."""
+    return Path(run_dir) / SUMMARY_MD
+
+
+def hydra_dir(run_dir: Path | str) -> Path:
+    """The run's Hydra record folder."""
+    return Path(run_dir) / HYDRA_DIR
+
+
+def results_tables(root: Path | str) -> list[Path]:
+    """Every run's ``results.csv`` below ``root`` (a run or a sweep directory), sorted."""
+    return sorted(Path(root).rglob(RESULTS_CSV))

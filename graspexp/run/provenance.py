@@ -1,0 +1,97 @@
+"""What every trial log records about where it came from: the job's config and seed, the data root, the
+package versions, the machine, and each trial's object; Hydra's record of an accepted run."""
+
+import functools
+import hashlib
+import platform
+from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
+
+from omegaconf import DictConfig, OmegaConf
+
+from graspexp.core.run_layout import hydra_dir
+from graspexp.datasets import resolve_root
+from graspexp.run.objects import LoadedObject
+
+PACKAGES = ("graspexp", "sapien", "numpy", "scikit-learn", "trimesh", "coacd", "mcap", "hydra-core")
+
+
+def package_versions() -> dict[str, str]:
+    """{package: version} of Python and of :data:`PACKAGES` ("unknown" for one not installed)."""
+    out = {"python": platform.python_version()}
+    for name in PACKAGES:
+        try:
+            out[name] = version(name)
+        except PackageNotFoundError:
+            out[name] = "unknown"
+    return out
+
+
+@functools.cache
+def machine_fingerprint() -> dict[str, str]:
+    """What a trial's floating point may depend on besides the code: CPU model, its instruction-set flags
+    (a hash: PhysX and numba pick vector paths by them), OS and architecture."""
+    cpu, flags = platform.processor() or "unknown", ""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            key, _, value = line.partition(":")
+            if key.strip() == "model name" and cpu in ("unknown", "", platform.machine()):
+                cpu = value.strip()
+            elif key.strip() in ("flags", "Features") and not flags:
+                flags = " ".join(sorted(value.split()))
+    except OSError:
+        pass
+    return {
+        "cpu": cpu,
+        "cpu_flags_sha256": hashlib.sha256(flags.encode()).hexdigest()[:16],
+        "platform": platform.platform(),
+        "arch": platform.machine(),
+    }
+
+
+def job_metadata(cfg: DictConfig) -> dict[str, str]:
+    """The part of every trial's MCAP metadata that is the same for the whole job: the config, the seed,
+    the data root it read, the package versions and the machine (:func:`machine_fingerprint`)."""
+    meta = {"config_yaml": OmegaConf.to_yaml(cfg, resolve=True), "global_seed": str(cfg.seed)}
+    meta["data_root"] = str(resolve_root(cfg.dataset).resolve())
+    meta.update({f"version.{k}": v for k, v in package_versions().items()})
+    meta.update({f"machine.{k}": v for k, v in machine_fingerprint().items()})
+    return meta
+
+
+def trial_metadata(job_meta: dict[str, str], loaded: LoadedObject, trial: int, seed: int) -> dict[str, str]:
+    """One trial's log metadata: the job's, the trial's seeds and what its object was made of (the mesh
+    file, "" for a procedural one, the SHA-256 of the geometry used with its face count, surface area and
+    volume, the collision method it got, and what was assumed for it: units, mass, area)."""
+    return {
+        **job_meta,
+        "object": loaded.model.name,
+        "trial": str(trial),
+        "trial_seed": str(seed),
+        "mesh_source": loaded.model.source,
+        "mesh_sha256": loaded.model.mesh_sha256,
+        **loaded.model.mesh_facts,
+        "collision_method": loaded.hulls.method,
+        "collision_key": loaded.hulls.key,
+        "object_notes": "\n".join(loaded.notes),
+    }
+
+
+def unusable_trial_metadata(
+    job_meta: dict[str, str], object_name: str, trial: int, seed: int
+) -> dict[str, str]:
+    """The log metadata of a trial whose object could not be loaded (no mesh facts to record)."""
+    return {**job_meta, "object": object_name, "trial": str(trial), "trial_seed": str(seed)}
+
+
+def write_hydra_record(cfg: DictConfig, run_dir: Path) -> None:
+    """Hydra's record of an accepted run, ``.hydra/{config,hydra,overrides}.yaml`` (written here, after the
+    checks, rather than by Hydra before them: ``hydra.output_subdir`` is null in ``conf/config.yaml``)."""
+    from hydra.core.hydra_config import HydraConfig
+
+    hc = HydraConfig.get()
+    folder = hydra_dir(run_dir)
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "config.yaml").write_text(OmegaConf.to_yaml(cfg))
+    (folder / "hydra.yaml").write_text(OmegaConf.to_yaml({"hydra": hc}))
+    (folder / "overrides.yaml").write_text(OmegaConf.to_yaml(list(hc.overrides.task)))
