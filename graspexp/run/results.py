@@ -136,14 +136,24 @@ def _job_key(overrides: Sequence[str]) -> str:
     return hashlib.sha256("\n".join(sorted(overrides)).encode()).hexdigest()[:16]
 
 
+class ResultsError(RuntimeError):
+    """A fingerprint job that cannot run (bad override, missing data): one line naming the job."""
+
+
 def _run_fingerprint_job(overrides: tuple[str, ...], run_dir: str) -> str:
     """Run one fingerprint job into ``run_dir`` (its printout swallowed); returns its results.csv path."""
+    from graspexp.config import ConfigError
     from graspexp.config.compose import compose_validated
+    from graspexp.datasets import DatasetError
+    from graspexp.run.locks import RunError
     from graspexp.run.runner import run_in_dir
 
-    cfg = compose_validated(list(overrides))  # run_in_dir makes it ready
-    with contextlib.redirect_stdout(io.StringIO()):
-        run_in_dir(cfg, Path(run_dir))
+    try:
+        cfg = compose_validated(list(overrides))  # run_in_dir makes it ready
+        with contextlib.redirect_stdout(io.StringIO()):
+            run_in_dir(cfg, Path(run_dir))
+    except (ConfigError, DatasetError, RunError) as exc:
+        raise ResultsError(f"the fingerprint job {shlex.join(overrides)} cannot run: {exc}") from None
     return str(Path(run_dir) / "results.csv")
 
 

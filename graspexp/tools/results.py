@@ -14,8 +14,9 @@ import shlex
 import sys
 from pathlib import Path
 
+from graspexp.report.pages import PageError
 from graspexp.run.result_pages import PAGES
-from graspexp.run.results import check, commit_of, regenerate
+from graspexp.run.results import ResultsError, check, commit_of, regenerate
 from graspexp.tools.cli import fail, positive_int, tool_parser
 
 PROG = "graspexp results"
@@ -41,18 +42,15 @@ def main(argv: list[str] | None = None) -> int:
     if unknown:
         fail(f"unknown page(s) {unknown}; the pages are {', '.join(p.name for p in PAGES)}", PROG)
     pages = [p for p in PAGES if not names or p.name in names]
-    if args.check:
-        problems = check(pages, args.root, args.n_jobs)
-    else:
-        out = args.out if args.out is not None else Path("outputs/results") / commit_of(args.root)[0]
-        problems = regenerate(
-            pages,
-            args.root,
-            out,
-            args.overrides,
-            shlex.join(["python", "-m", "graspexp", "results", *argv]),
-            args.n_jobs,
-        )
+    out = args.out if args.out is not None else Path("outputs/results") / commit_of(args.root)[0]
+    command = shlex.join(["python", "-m", "graspexp", "results", *argv])
+    try:
+        if args.check:
+            problems = check(pages, args.root, args.n_jobs)
+        else:
+            problems = regenerate(pages, args.root, out, args.overrides, command, args.n_jobs)
+    except (ResultsError, PageError) as exc:
+        fail(str(exc), PROG)
     for line in problems:
         print(f"{PROG}: {line}", file=sys.stderr)
     return 1 if problems else 0
