@@ -131,3 +131,22 @@ def test_check_passes_on_the_same_code_and_fails_when_a_planner_changes(tmp_path
     assert done.returncode == 1, done.stderr[-2000:]
     assert "page.md: made at commit" in done.stdout and "the current code gives" in done.stdout
     assert "python -m graspexp results --pages fake" in done.stdout
+
+
+def test_a_sweep_marked_done_is_skipped_and_the_launcher_is_an_override(tmp_path: Path, capsys):
+    from graspexp.run.results import DONE_NAME, Sweep, run_sweep
+    from graspexp.run.suites import ALL, reading_sweep
+
+    sweep = Sweep(ALL["default"], ("trials=3",))
+    (tmp_path / sweep.name).mkdir()
+    (tmp_path / sweep.name / DONE_NAME).write_text(
+        '{"command": "c", "rc": 0, "wall_s": 90.0, "cpu_s": 170.0}'
+    )
+    done = run_sweep(sweep, tmp_path, [], "[1/1]")
+    assert done.skipped and (done.wall_s, done.cpu_s) == (90.0, 170.0)
+    assert f"[1/1] {sweep.name}: done before (90 s), skipped" in capsys.readouterr().err
+    slurm = reading_sweep(
+        ALL["default"], tmp_path, ["hydra/launcher=submitit_slurm", "hydra.launcher.partition=p"]
+    )
+    assert "hydra/launcher=joblib" not in slurm and "hydra/launcher=submitit_slurm" in slurm
+    assert "hydra/launcher=joblib" in reading_sweep(ALL["default"], tmp_path)
