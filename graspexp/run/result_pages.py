@@ -83,7 +83,7 @@ GENERALISATION = _sweeps(
 ABLATION = tuple(Sweep(r, ("trials=5",)) for r in ABLATIONS)
 
 PAGES: tuple[Page, ...] = (
-    Page("readme", "README.md", (DEFAULT,), _readme(DEFAULT), (DEFAULT,)),
+    Page("readme", "README.md", (DEFAULT,), _readme(DEFAULT), (DEFAULT,), admonition=False),
     Page(
         "index",
         "docs/results/index.md",

@@ -96,6 +96,8 @@ class Page:
     """Sweeps whose outcomes this page's numbers depend on; each runs on :data:`FINGERPRINT_SETTINGS`
     with ``fingerprint_subset``."""
     fingerprint_subset: tuple[str, ...] = FINGERPRINT_SUBSET
+    admonition: bool = True
+    """Whether the provenance is a Markdown admonition (the site) or plain paragraphs (the README)."""
 
 
 @dataclass
@@ -285,7 +287,8 @@ def regenerate(
                 fingerprint=fingerprints[page.name],
                 fingerprint_trials=_fingerprint_trials(page),
                 fingerprint_jobs=tuple(" ".join(j) for j in jobs),
-            )
+            ),
+            page.admonition,
         )
         work.mkdir(parents=True, exist_ok=True)
         body = page.render(PageInput({s: out / "runs" / s.name for s in page.sweeps}, assets, work))
