@@ -52,9 +52,9 @@ def _agreement_and_gallery(sweep: Sweep) -> Callable[[PageInput], str]:
         prefix = f"{page.assets.name}/"
         md = []
         for ag in report.agreements:
-            md.append(
-                embed("\n".join(agreement_section(ag, report.collected.results, page.assets)), prefix=prefix)
-            )
+            text = "\n".join(agreement_section(ag, report.collected.results, page.assets))
+            (page.assets / f"{ag.name}.md").unlink()  # the site links its CSV: every cell
+            md.append(embed(text.replace(f"]({ag.name}.md)", f"]({ag.name}.csv)"), prefix=prefix))
         gallery = write_gallery(report.collected.results, page.assets, GALLERY_PER_REASON)
         (page.assets / "gallery.md").unlink()  # the page embeds it
         md.append("## Failures of `" + sweep.reading.name + "`, one per setting and reason\n")
