@@ -120,12 +120,16 @@ def merged(*groups: Sequence[str]) -> tuple[str, ...]:
     return tuple(out.values())
 
 
-def fingerprint_jobs(page: Page) -> list[tuple[str, ...]]:
-    """The override lists of ``page``'s fingerprint jobs (``record=false``, no progress bars)."""
+def fingerprint_jobs(page: Page, overrides: Sequence[str] = ()) -> list[tuple[str, ...]]:
+    """The override lists of ``page``'s fingerprint jobs (``record=false``, no progress bars); the job
+    overrides among ``overrides`` (those given to every sweep; not ``hydra.*``) go to them too, under
+    the page's fingerprint subset."""
+    shared = [o for o in overrides if not o.lstrip("+~").startswith("hydra")]
     return [
         merged(
             s.reading.overrides,
             s.extra,
+            shared,
             page.fingerprint_subset,
             (f"mode={mode}", f"rot={rot}", "record=false", "progress=false"),
         )
@@ -159,12 +163,15 @@ def _run_fingerprint_job(overrides: tuple[str, ...], run_dir: str) -> str:
     return str(Path(run_dir) / "results.csv")
 
 
-def run_fingerprints(pages: Sequence[Page], out: Path, n_jobs: int) -> dict[str, str]:
-    """Run every fingerprint job of ``pages`` once (jobs two pages share run once) into ``out`` (emptied
-    first: a fingerprint never reuses a trial) with ``n_jobs`` processes; returns each page's fingerprint."""
+def run_fingerprints(
+    pages: Sequence[Page], out: Path, n_jobs: int, overrides: Sequence[str] = ()
+) -> dict[str, str]:
+    """Run every fingerprint job of ``pages`` (:func:`fingerprint_jobs` with ``overrides``) once (jobs two
+    pages share run once) into ``out`` (emptied first: a fingerprint never reuses a trial) with ``n_jobs``
+    processes; returns each page's fingerprint."""
     from joblib import Parallel, delayed
 
-    jobs = {_job_key(j): j for page in pages for j in fingerprint_jobs(page)}
+    jobs = {_job_key(j): j for page in pages for j in fingerprint_jobs(page, overrides)}
     shutil.rmtree(out, ignore_errors=True)
     out.mkdir(parents=True)
     start = time.perf_counter()
@@ -173,7 +180,8 @@ def run_fingerprints(pages: Sequence[Page], out: Path, n_jobs: int) -> dict[str,
     tables = {k: pd.read_csv(p, dtype=str, keep_default_na=False) for k, p in zip(jobs, paths, strict=True)}
     print(f"graspexp results: fingerprints: {time.perf_counter() - start:.0f} s", file=sys.stderr)
     return {
-        page.name: outcome_fingerprint(tables[_job_key(j)] for j in fingerprint_jobs(page)) for page in pages
+        page.name: outcome_fingerprint(tables[_job_key(j)] for j in fingerprint_jobs(page, overrides))
+        for page in pages
     }
 
 
@@ -263,7 +271,7 @@ def regenerate(
         users = ", ".join(p.name for p in pages if sweep in p.sweeps)
         times[sweep] = run_sweep(sweep, out / "runs", overrides, f"[{i}/{len(sweeps)}] ({users})")
     failed = {s for s, t in times.items() if t.rc != 0}
-    fingerprints = run_fingerprints(pages, out / "fingerprint", n_jobs)
+    fingerprints = run_fingerprints(pages, out / "fingerprint", n_jobs, overrides)
     problems = [f"sweep {s.name} exited {times[s].rc}: {times[s].command}" for s in failed]
     for page in pages:
         if failed & set(page.sweeps):
@@ -273,7 +281,7 @@ def regenerate(
         assets, work = path.parent / f"{path.stem}_files", out / "pages" / page.name
         own = [times[s] for s in page.sweeps]
         cpu = None if any(t.cpu_s is None for t in own) else sum(t.cpu_s or 0.0 for t in own)
-        jobs = fingerprint_jobs(page)
+        jobs = fingerprint_jobs(page, overrides)
         head = provenance(
             Provenance(
                 page=page.name,
@@ -285,7 +293,7 @@ def regenerate(
                 wall_s=sum(t.wall_s for t in own),
                 cpu_s=cpu,
                 fingerprint=fingerprints[page.name],
-                fingerprint_trials=_fingerprint_trials(page),
+                fingerprint_trials=_fingerprint_trials(jobs),
                 fingerprint_jobs=tuple(" ".join(j) for j in jobs),
             ),
             page.admonition,
@@ -294,17 +302,23 @@ def regenerate(
         body = page.render(PageInput({s: out / "runs" / s.name for s in page.sweeps}, assets, work))
         path.write_text(replace_block(path.read_text(), head + "\n" + body, str(path)))
         print(f"graspexp results: wrote {path}", file=sys.stderr)
-    print(f"graspexp results: {duration(time.perf_counter() - total)} wall in all", file=sys.stderr)
+    ran = [t for t in times.values() if not t.skipped]
+    cpu_all = "n/a" if any(t.cpu_s is None for t in ran) else duration(sum(t.cpu_s or 0.0 for t in ran))
+    print(
+        f"graspexp results: {len(ran)} sweeps run now ({len(times) - len(ran)} done before), "
+        f"{duration(time.perf_counter() - total)} wall in all; the sweeps run now {cpu_all} CPU",
+        file=sys.stderr,
+    )
     return problems
 
 
-def _fingerprint_trials(page: Page) -> int:
-    """Trials of ``page``'s fingerprint: objects x trials per job, summed."""
+def _fingerprint_trials(jobs: Sequence[Sequence[str]]) -> int:
+    """Trials of the fingerprint ``jobs``: objects x trials per job, summed."""
     from graspexp.datasets import select_objects
     from graspexp.run.job_config import compose_job
 
     n = 0
-    for job in fingerprint_jobs(page):
+    for job in jobs:
         cfg = compose_job(list(job))
         n += len(select_objects(cfg.dataset, cfg.objects)) * int(cfg.trials)
     return n
