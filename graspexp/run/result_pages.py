@@ -12,11 +12,30 @@ from graspexp.report.build import agreement_section, build_report
 from graspexp.report.gallery import write_gallery
 from graspexp.report.pages import embed
 from graspexp.report.readings import beside_paper, reading_averages, readings_report
+from graspexp.report.study import plot_study, read_sweep_study, study_table
+from graspexp.report.tuning import scored_trial, tuning_markdown
 from graspexp.run.results import Page, PageInput, Sweep
-from graspexp.run.suites import ABLATIONS, ALL, READINGS
+from graspexp.run.score import score_study
+from graspexp.run.suites import ABLATIONS, ALL, READINGS, Reading
 
 GALLERY_PER_REASON = 1
 """Failures drawn per dataset, setting and reason in a page's gallery."""
+SCORE_TRIALS = 20
+"""Trials per held-out object when a tuning page scores its study's constants."""
+STUDY = (
+    "hydra/sweeper=study",
+    "mode=bin",
+    "dataset=ycb",
+    "dataset.split=train",
+    "trials=10",
+    "record=false",
+    "cost.angle_weight=tag(log, interval(0.01, 1))",
+    "cost.distance_numerator_mm2=tag(log, interval(2, 200))",
+    "cost.distance_offset_mm2=tag(log, interval(0.1, 10))",
+    "cost.table_beta_divisor=tag(log, interval(0.2, 20))",
+    "cost.table_offset=tag(log, interval(0.005, 0.5))",
+)
+"""An Optuna study of Eq. (1)-(3)'s constants in bin picking on the training objects (docs/guide/tuning.md)."""
 
 
 def _sweeps(names: Sequence[str], extra: tuple[str, ...] = ()) -> tuple[Sweep, ...]:
@@ -64,6 +83,25 @@ def _agreement_and_gallery(sweep: Sweep) -> Callable[[PageInput], str]:
     return render
 
 
+def _tuning(sweep: Sweep) -> Callable[[PageInput], str]:
+    """The study's report (:func:`graspexp.report.tuning.tuning_markdown`): its trials, the baseline and
+    the scored trial (:func:`graspexp.report.tuning.scored_trial`) on the held-out objects, the plots."""
+
+    def render(page: PageInput) -> str:
+        study_dir = page.runs[sweep]
+        found = read_sweep_study(study_dir)
+        trial = scored_trial(found.study)
+        scored = score_study(found, study_dir, "test", SCORE_TRIALS, (), trial)
+        page.assets.mkdir(parents=True, exist_ok=True)
+        study_table(found.study).to_csv(page.assets / "tuning_trials.csv", index=False)
+        pngs = [p.name for p in plot_study(found.study, page.assets)]
+        command = f"python -m graspexp tune {study_dir} --trials {SCORE_TRIALS}"
+        command += f" --trial {trial}" if trial is not None else ""
+        return embed(tuning_markdown(found, scored, command, pngs), prefix=f"{page.assets.name}/")
+
+    return render
+
+
 def _readme(sweep: Sweep) -> Callable[[PageInput], str]:
     def render(page: PageInput) -> str:
         avg = reading_averages({sweep.reading.name: (page.runs[sweep], sweep.reading.what)})
@@ -81,6 +119,16 @@ GENERALISATION = _sweeps(
     ("dataset=ycb", "dataset.split=test"),
 )
 ABLATION = tuple(Sweep(r, ("trials=5",)) for r in ABLATIONS)
+STUDY_Z = Sweep(
+    Reading(
+        "tuning_bin_z", (*STUDY, "rot=z", "hydra.sweeper.n_trials=60"), "the constants' study, bin, rot z"
+    ),
+    settings=False,
+)
+STUDY_XYZ = Sweep(
+    Reading("tuning_bin_xyz", (*STUDY, "rot=xyz", "hydra.sweeper.n_trials=40"), "the same study, rot xyz"),
+    settings=False,
+)
 
 PAGES: tuple[Page, ...] = (
     Page("readme", "README.md", (DEFAULT,), _readme(DEFAULT), (DEFAULT,), admonition=False),
@@ -127,5 +175,7 @@ PAGES: tuple[Page, ...] = (
             Sweep(ALL[n], ("trials=5",)) for n in ("plus", "plus_choose_cost", "plus_noise", "default_noise")
         ),
     ),
+    Page("tuning", "docs/results/tuning.md", (STUDY_Z,), _tuning(STUDY_Z), (DEFAULT,)),
+    Page("tuning_xyz", "docs/results/xyz/tuning.md", (STUDY_XYZ,), _tuning(STUDY_XYZ), (DEFAULT,)),
 )
 """Every results page, in the order they are regenerated."""

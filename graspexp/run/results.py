@@ -46,6 +46,7 @@ from graspexp.report.pages import (
     read_stamp,
     replace_block,
 )
+from graspexp.run.multirun import multirun_command
 from graspexp.run.suites import Reading, reading_sweep
 
 FINGERPRINT_SETTINGS: tuple[tuple[str, str], ...] = (("collab", "z"), ("bin", "xyz"))
@@ -63,6 +64,9 @@ class Sweep:
 
     reading: Reading
     extra: tuple[str, ...] = ()
+    settings: bool = True
+    """Run on the paper's four settings and both tables (:func:`graspexp.run.suites.reading_sweep`);
+    False: the reading's overrides are the whole sweep (e.g. an Optuna study, ``hydra/sweeper=study``)."""
 
     @property
     def name(self) -> str:
@@ -231,7 +235,14 @@ def run_sweep(sweep: Sweep, out: Path, overrides: Sequence[str], label: str) -> 
     """Run (or resume) one sweep into ``out/<sweep.name>``; a sweep marked done is skipped."""
     sweep_dir = out / sweep.name
     marker = sweep_dir / DONE_NAME
-    command = reading_sweep(sweep.reading, out, [*sweep.extra, *overrides], sweep_dir=sweep_dir)
+    given = [*sweep.extra, *overrides]
+    if sweep.settings:
+        command = reading_sweep(sweep.reading, out, given, sweep_dir=sweep_dir)
+    else:
+        launcher = {"launcher": ()} if any(o.startswith("hydra/launcher=") for o in given) else {}
+        command = multirun_command(
+            sweep_dir, ["progress=false", *sweep.reading.overrides, *given], **launcher
+        )
     shown = shlex.join(["python", *command[1:]])
     if marker.is_file():
         done = SweepTime(**json.loads(marker.read_text()))

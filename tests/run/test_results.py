@@ -150,3 +150,22 @@ def test_a_sweep_marked_done_is_skipped_and_the_launcher_is_an_override(tmp_path
     )
     assert "hydra/launcher=joblib" not in slurm and "hydra/launcher=submitit_slurm" in slurm
     assert "hydra/launcher=joblib" in reading_sweep(ALL["default"], tmp_path)
+
+
+def test_a_tuning_page_scores_the_best_trial_or_the_farthest_tie():
+    import optuna
+
+    from graspexp.report.tuning import scored_trial
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+
+    def study(values: list[tuple[float, float]]) -> optuna.Study:
+        s = optuna.create_study(direction="maximize")
+        dist = {"x": optuna.distributions.FloatDistribution(0.01, 100, log=True)}
+        for x, v in values:
+            s.add_trial(optuna.trial.create_trial(params={"x": x}, distributions=dist, value=v))
+        return s
+
+    assert scored_trial(study([(1.0, 0.9), (2.0, 0.95), (50.0, 0.9)])) is None  # trial 1 beat the baseline
+    assert scored_trial(study([(1.0, 0.9), (2.0, 0.9), (0.05, 0.9), (30.0, 0.8)])) == 2  # 20x, tied
+    assert scored_trial(study([(1.0, 0.9), (3.0, 0.8)])) is None  # no tie: the best is trial 0 itself
