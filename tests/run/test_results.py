@@ -161,7 +161,7 @@ def test_a_tuning_page_scores_the_best_trial_or_the_farthest_tie():
 
     def study(values: list[tuple[float, float]]) -> optuna.Study:
         s = optuna.create_study(direction="maximize")
-        dist = {"x": optuna.distributions.FloatDistribution(0.01, 100, log=True)}
+        dist = {"x": optuna.distributions.LogUniformDistribution(0.01, 100)}
         for x, v in values:
             s.add_trial(optuna.trial.create_trial(params={"x": x}, distributions=dist, value=v))
         return s
