@@ -19,6 +19,7 @@ fingerprint jobs into a temporary folder and compares each page's stamp.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import datetime
 import hashlib
 import io
@@ -112,6 +113,8 @@ class SweepTime:
     rc: int
     wall_s: float
     cpu_s: float | None
+    commit: str = ""
+    """The commit the sweep ran at."""
     skipped: bool = field(default=False)
 
 
@@ -231,8 +234,9 @@ def _remote(overrides: Sequence[str]) -> bool:
     return any(o.startswith("hydra/launcher=submitit_slurm") for o in overrides)
 
 
-def run_sweep(sweep: Sweep, out: Path, overrides: Sequence[str], label: str) -> SweepTime:
-    """Run (or resume) one sweep into ``out/<sweep.name>``; a sweep marked done is skipped."""
+def run_sweep(sweep: Sweep, out: Path, overrides: Sequence[str], label: str, commit: str = "") -> SweepTime:
+    """Run (or resume) one sweep into ``out/<sweep.name>`` at ``commit``; a sweep marked done is skipped
+    (with a warning when it was made at another commit: its trials are then not of this code)."""
     sweep_dir = out / sweep.name
     marker = sweep_dir / DONE_NAME
     given = [*sweep.extra, *overrides]
@@ -247,7 +251,13 @@ def run_sweep(sweep: Sweep, out: Path, overrides: Sequence[str], label: str) -> 
     if marker.is_file():
         done = SweepTime(**json.loads(marker.read_text()))
         print(f"{label} {sweep.name}: done before ({duration(done.wall_s)}), skipped", file=sys.stderr)
-        return SweepTime(done.command, done.rc, done.wall_s, done.cpu_s, skipped=True)
+        if done.commit != commit:
+            print(
+                f"{label} {sweep.name}: warning: made at commit {done.commit or 'unknown'}, not {commit}; "
+                "choose another --out to run it with this code",
+                file=sys.stderr,
+            )
+        return dataclasses.replace(done, skipped=True)
     print(f"{label} {sweep.name}: {sweep.reading.what}\n  {shown}", file=sys.stderr, flush=True)
     before, start = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
     rc = subprocess.call(command)
@@ -257,7 +267,7 @@ def run_sweep(sweep: Sweep, out: Path, overrides: Sequence[str], label: str) -> 
         if _remote(overrides)
         else (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     )
-    result = SweepTime(shown, rc, wall, cpu)
+    result = SweepTime(shown, rc, wall, cpu, commit)
     print(f"{label} {sweep.name}: {duration(wall)} wall, exit {rc}", file=sys.stderr, flush=True)
     if rc == 0:
         marker.write_text(json.dumps({k: v for k, v in vars(result).items() if k != "skipped"}))
@@ -280,7 +290,7 @@ def regenerate(
     total = time.perf_counter()
     for i, sweep in enumerate(sweeps, 1):
         users = ", ".join(p.name for p in pages if sweep in p.sweeps)
-        times[sweep] = run_sweep(sweep, out / "runs", overrides, f"[{i}/{len(sweeps)}] ({users})")
+        times[sweep] = run_sweep(sweep, out / "runs", overrides, f"[{i}/{len(sweeps)}] ({users})", commit)
     failed = {s for s, t in times.items() if t.rc != 0}
     fingerprints = run_fingerprints(pages, out / "fingerprint", n_jobs, overrides)
     problems = [f"sweep {s.name} exited {times[s].rc}: {times[s].command}" for s in failed]
