@@ -133,14 +133,18 @@ class Provenance:
     fingerprint_trials: int
     fingerprint_jobs: tuple[str, ...]
     """Each fingerprint job's overrides, space-separated."""
+    sweep_commits: tuple[str, ...] = ()
+    """The commits the sweeps ran at, where a resumed regeneration reused sweeps of another commit."""
 
 
 def provenance(p: Provenance, admonition: bool = True) -> str:
     """The block's opening: how the numbers were made, as a Markdown admonition (plain paragraphs with
     ``admonition=False``, for the README), after the :func:`stamp` line."""
     cpu = f", {duration(p.cpu_s)} CPU" if p.cpu_s is not None else " (CPU time not measured: remote jobs)"
+    other = [c for c in dict.fromkeys(p.sweep_commits) if c != p.commit]
+    at = f" (sweeps run at commit {', '.join(other)})" if other else ""
     text = [
-        f"`{p.command}` at commit {p.commit} ({p.date}) on {p.machine}: the sweeps took "
+        f"`{p.command}` at commit {p.commit} ({p.date}){at} on {p.machine}: the sweeps took "
         f"{duration(p.wall_s)} wall{cpu}. Each sweep resumes where it stopped when run again:",
         "",
         *(f"    {s}" for s in p.sweeps),

@@ -230,7 +230,10 @@ def beside_paper(avg: pd.DataFrame, reading: str, label: str) -> str:
     """A Markdown table, one row per paper setting: ``reading``'s success (%) on each dataset (columns
     named by ``label``) beside the paper's average over the same objects."""
     sub = avg[avg["reading"] == reading]
-    datasets = list(dict.fromkeys(sub["dataset"]))
+    order = list(PAPER_TABLES)
+    datasets = sorted(
+        dict.fromkeys(sub["dataset"]), key=lambda d: (order.index(d) if d in order else len(order), d)
+    )
     rows = []
     for mode, rot in SETTINGS:
         row = {"setting": SETTING_LABELS[(mode, rot)]}

@@ -316,6 +316,7 @@ def regenerate(
                 fingerprint=fingerprints[page.name],
                 fingerprint_trials=_fingerprint_trials(jobs),
                 fingerprint_jobs=tuple(" ".join(j) for j in jobs),
+                sweep_commits=tuple(t.commit or "unknown" for t in own),
             ),
             page.admonition,
         )
