@@ -1,7 +1,9 @@
-"""Sessions CI and developers call: ``nox -s tests``, ``nox -s lint``, ``nox -s docs``, ``nox -s bench``,
-``nox -s reproduce``, ``nox -s results``, ``nox -s slurm``."""
+"""Sessions CI and developers call: ``nox -s tests``, ``nox -s lint``, ``nox -s docs``, ``nox -s wheel``,
+``nox -s bench``, ``nox -s reproduce``, ``nox -s results``, ``nox -s slurm``."""
 
 import os
+import shutil
+import tempfile
 import time
 from pathlib import Path
 
@@ -44,12 +46,67 @@ def docs(session: nox.Session) -> None:
     session.log(f"docs: built in {time.perf_counter() - start:.1f} s")
 
 
+WHEEL_SOURCE_SKIPS = {"build", "outputs", "datasets", "docs", "tests", "examples"}
+"""Top-level entries ``nox -s wheel`` leaves out of the copy it builds from (with every top-level dot entry:
+.git, .venv, .nox, caches; and ``__pycache__`` and egg-info anywhere): build outputs, data, runs."""
+
+
+def _wheel_source_skips(folder: str, names: list[str]) -> set[str]:
+    top = Path(folder) == HERE
+    return {
+        n
+        for n in names
+        if (top and (n in WHEEL_SOURCE_SKIPS or n.startswith(".")))
+        or n == "__pycache__"
+        or n.endswith(".egg-info")
+    }
+
+
+@nox.session(reuse_venv=False)
+def wheel(session: nox.Session) -> None:
+    """The installed app, not the checkout: build the wheel, install it (the tested dependency set,
+    ``constraints.txt``, from the pip cache) into a fresh venv, then from an empty temporary folder run a
+    job (the procedural objects, 1 trial each), ``report`` on it and ``plan``. Fails if ``graspexp`` or
+    its YAML (``conf/``, shipped as ``graspexp.conf``) is found anywhere but in the venv."""
+    start = time.perf_counter()
+    tmp = Path(session.create_tmp())
+    src, dist = tmp / "src", tmp / "dist"
+    shutil.rmtree(src, ignore_errors=True)
+    shutil.rmtree(dist, ignore_errors=True)
+    # built from a copy without build outputs: setuptools would package a stale build/lib (a module
+    # removed since the last build) and the checkout's egg-info
+    shutil.copytree(HERE, src, ignore=_wheel_source_skips)
+    session.run("python", "-m", "pip", "wheel", "-q", "--no-deps", "-w", str(dist), str(src))
+    (built,) = dist.glob("graspexp-*.whl")
+    # from the pip cache; not byte-compiled at install (the job compiles what it imports), which halves the
+    # install's CPU time
+    session.install("-q", "--no-compile", str(built), "-c", str(HERE / "constraints.txt"))
+    installed_s = time.perf_counter() - start
+    with tempfile.TemporaryDirectory(prefix="graspexp-wheel-") as work:
+        session.chdir(work)
+        env = {**ENV, "PYTHONPATH": ""}
+        where = "import graspexp.config.registry as r; print(r.__file__); print(r.CONF_DIR)"
+        found = session.run("python", "-c", where, silent=True, env=env).split()
+        session.log(f"wheel: graspexp from {found[0]}, its YAML from {found[1]}")
+        if any(not path.startswith(session.virtualenv.location) for path in found):
+            session.error(f"wheel: graspexp or its conf/ found outside the venv: {found}")
+        job = ["dataset=primitives", "trials=1", "progress=false", "hydra.run.dir=run"]
+        session.run("graspexp", *job, env=env)
+        session.run("graspexp", "report", "run", env=env)
+        session.run("graspexp", "plan", "dataset=primitives", "objects=[can]", env=env)
+    session.log(
+        f"wheel: built and installed in {installed_s:.1f} s, total {time.perf_counter() - start:.1f} s wall"
+    )
+
+
 @nox.session
 def bench(session: nox.Session) -> None:
-    """Planner latency per Table 1 object, the per-phase trial benchmark, then the 720-trial reproduction
+    """Planner latency per Table 1 object, registration accuracy and depth + registration time per Table
+    1/2 object (the camera extra), the per-phase trial benchmark, then the 720-trial reproduction
     (logged, warm collision cache) with 1 and 2 workers."""
-    session.install("-e", ".")
+    session.install("-e", ".[camera]")
     session.run("python", "-m", "graspexp", "bench.plan_latency", *session.posargs, env=ENV)
+    session.run("python", "-m", "graspexp", "bench.registration", *session.posargs, env=ENV)
     session.run("python", "-m", "graspexp", "bench.trials", *session.posargs, env=ENV)
     session.run("python", "-m", "graspexp", "bench.reproduce", *session.posargs, env=ENV)
 

@@ -27,8 +27,6 @@ earlier level. The stages of one level import neither each other: objects (``dat
 what exists, side by side; the camera (``perception``) looks at both; planners get what it gives."""
 STAGES = tuple(stage for level in LEVELS for stage in level)
 LEVEL = {stage: i for i, level in enumerate(LEVELS) for stage in level}
-OPTIONAL_STAGES = frozenset({"perception"})
-"""Stages whose package (and tests folder) may be absent: the camera lands in its own branch."""
 STAGE_OF_PACKAGE = {**{s: s for s in STAGES}, "quality": "planning"}
 """Packages that belong to a stage without carrying its name (grasp quality is a planning-side check)."""
 BASE_PACKAGE = "core"
@@ -83,7 +81,7 @@ def test_top_level_holds_only_packages_and_the_entry_point():
     assert modules == ["__init__.py", "__main__.py"], modules
     packages = {p.name for p in PACKAGE.iterdir() if (p / "__init__.py").is_file()}
     expected = {*STAGE_OF_PACKAGE, BASE_PACKAGE, TOOLS_PACKAGE, *TOOL_ALIASES}
-    assert expected - OPTIONAL_STAGES <= packages <= expected, packages
+    assert packages == expected, packages
 
 
 def test_stages_import_one_way():
@@ -137,8 +135,8 @@ def test_planning_loads_neither_hydra_nor_sapien():
 
 def test_tests_are_laid_out_by_stage():
     tests = Path(__file__).parent
-    dirs = {p.name for p in tests.iterdir() if p.is_dir() and not p.name.startswith((".", "_"))}
-    assert {*STAGES, TOOLS_PACKAGE} - OPTIONAL_STAGES <= dirs <= {*STAGES, TOOLS_PACKAGE}, dirs
+    dirs = {p.name for p in tests.iterdir() if p.is_dir() and not p.name.startswith((".", "_"))} - {"helpers"}
+    assert dirs == {*STAGES, TOOLS_PACKAGE}, dirs
     assert sorted(p.name for p in tests.glob("*.py")) == ["conftest.py", "test_architecture.py"]
 
 
@@ -146,6 +144,8 @@ FILE_READERS = frozenset({"trimesh", "xml", "open3d", "sapien", "pymeshfix", "co
 """Libraries that read mesh or URDF files: the config stage imports none of them."""
 FILE_CALLS = frozenset({"open", "read_text", "read_bytes", "load_hand", "hand_of"})
 """Calls that open a file (or a gripper's URDF): the config stage makes none of them."""
+READS_PRESETS = frozenset({"reference.py"})
+"""config/ modules that read the presets' own YAML (``conf/``) to document them: never a mesh or URDF."""
 
 
 def test_the_config_stage_opens_no_mesh_or_urdf_file():
@@ -161,7 +161,7 @@ def test_the_config_stage_opens_no_mesh_or_urdf_file():
             elif isinstance(node, ast.Call):
                 f = node.func
                 name = f.id if isinstance(f, ast.Name) else f.attr if isinstance(f, ast.Attribute) else ""
-                if name in FILE_CALLS:
+                if name in FILE_CALLS and path.name not in READS_PRESETS:
                     wrong.append(f"{path.relative_to(PACKAGE)}:{node.lineno} calls {name}")
                 continue
             else:

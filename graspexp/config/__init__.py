@@ -9,8 +9,9 @@ from graspexp.config.constraints import BEFORE, added
 from graspexp.config.cost import CostConfig
 from graspexp.config.dataset import DatasetConfig
 from graspexp.config.gripper import GripperConfig
-from graspexp.config.job import JobConfig, PerceptionConfig, PoseNoiseConfig
+from graspexp.config.job import JobConfig
 from graspexp.config.mode import ModeConfig
+from graspexp.config.perception import CameraConfig, PerceptionConfig, PoseNoiseConfig
 from graspexp.config.planner import (
     BASE_CONSTRAINTS,
     AntipodalConfig,
@@ -31,6 +32,7 @@ __all__ = [
     "added",
     "BASE_CONSTRAINTS",
     "AntipodalConfig",
+    "CameraConfig",
     "ObbConfig",
     "OptimalConfig",
     "OptimalPlusConfig",

@@ -10,24 +10,12 @@ from graspexp.config.cost import CostConfig
 from graspexp.config.dataset import DatasetConfig
 from graspexp.config.gripper import GripperConfig
 from graspexp.config.mode import ModeConfig
+from graspexp.config.perception import PerceptionConfig
 from graspexp.config.rot import RotConfig
 from graspexp.config.sim import SimConfig
 
 OBJECTIVES = ("success", "worst_object")
 """The values of ``objective`` (what a job returns to a sweeper)."""
-
-
-@dataclass
-class PoseNoiseConfig:
-    trans_mm: float = 0.0
-    """Std-dev of the Gaussian translation error added to the pose the planner sees, mm."""
-    rot_deg: float = 0.0
-    """Std-dev of the rotation-angle error (random axis) added to that pose, degrees."""
-
-
-@dataclass
-class PerceptionConfig:
-    noise: PoseNoiseConfig = field(default_factory=PoseNoiseConfig)
 
 
 @dataclass
@@ -62,12 +50,6 @@ class JobConfig:
     job runs them, this equals the mean over all trials); ``worst_object``: the lowest object's success
     rate (tunes for the hardest object). A job that cannot run returns None (the study marks it FAIL)."""
 
-
-POSE_NOISE_CONSTRAINTS = {
-    "trans_mm": [Interval(0, 1000, unit="mm")],
-    "rot_deg": [Interval(0, 180, unit="deg")],
-}
-"""Allowed values of every ``perception.noise`` key (see :mod:`graspexp.config.constraints`)."""
 
 JOB_CONSTRAINTS = {
     "trials": [Interval(1, 100_000, integer=True)],

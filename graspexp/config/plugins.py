@@ -38,12 +38,16 @@ class PlannerPlugin:
     constraints : allowed values of every field of ``config``, inherited ones included
         (``{**BASE_CONSTRAINTS, ...}``; see :mod:`graspexp.config.constraints`).
     version : the planner's version, recorded with every result; default the package's version.
+    needs_observation : the planner reads the depth camera's output (``PlanRequest.observation``): the
+        trial renders the camera for it even with ``perception.source=truth`` (the camera extra must be
+        installed).
     """
 
     plan: Callable[..., Any] | str
     config: type[PlannerConfig]
     constraints: Mapping[str, list]
     version: str = ""
+    needs_observation: bool = False
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,7 @@ from graspexp.config.errors import ConfigError
 from graspexp.config.gripper import GripperConfig
 from graspexp.config.job import JobConfig
 from graspexp.config.mode import ModeConfig
+from graspexp.config.perception import CameraConfig
 from graspexp.config.plugins import LoadedPlanner, PluginError, get_plugin, load_planners
 from graspexp.config.rot import RotConfig
 from graspexp.config.sim import SimConfig
@@ -69,6 +70,7 @@ def register_configs() -> None:
     cs.store(name=schema_name("job"), node=JobConfig)
     for group, schema in SCHEMAS.items():
         cs.store(name=schema_name(group), node=schema)
+    cs.store(name=schema_name("camera"), node=CameraConfig)  # the group perception/camera
     presets = _yaml_options("planner")
     for name, found in load_planners().items():
         if isinstance(found, LoadedPlanner):

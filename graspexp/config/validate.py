@@ -13,7 +13,7 @@ from typing import Any
 
 from omegaconf import DictConfig, OmegaConf
 
-from graspexp.config import cost, dataset, gripper, job, mode, rot, sim
+from graspexp.config import cost, dataset, gripper, job, mode, perception, rot, sim
 from graspexp.config.constraints import accepts, describe
 from graspexp.config.errors import ConfigError
 from graspexp.config.plugins import PluginError, get_plugin
@@ -21,8 +21,11 @@ from graspexp.config.registry import SCHEMAS, group_options
 
 SCHEMA_CONSTRAINTS: dict[type, dict[str, list]] = {
     job.JobConfig: job.JOB_CONSTRAINTS,
-    job.PoseNoiseConfig: job.POSE_NOISE_CONSTRAINTS,
-    job.PerceptionConfig: {},
+    perception.PoseNoiseConfig: perception.POSE_NOISE_CONSTRAINTS,
+    perception.PerceptionConfig: perception.PERCEPTION_CONSTRAINTS,
+    perception.CameraConfig: perception.CAMERA_CONSTRAINTS,
+    perception.DepthNoiseConfig: perception.DEPTH_NOISE_CONSTRAINTS,
+    perception.RegistrationConfig: perception.REGISTRATION_CONSTRAINTS,
     dataset.DatasetConfig: dataset.CONSTRAINTS,
     gripper.GripperConfig: gripper.CONSTRAINTS,
     mode.ModeConfig: mode.CONSTRAINTS,
@@ -38,6 +41,7 @@ RELATIONS = (
     ("gripper.min_width_m", "<", "gripper.max_width_m"),
     ("sim.rest_offset_m", "<", "sim.contact_offset_m"),
     ("sim.settle_min_s", "<=", "sim.settle_max_s"),
+    ("perception.camera.min_range_m", "<", "perception.camera.max_range_m"),
 )
 """Pairs of keys whose values must keep this order."""
 URDF_OPTION = "urdf"
@@ -131,3 +135,20 @@ def validate(cfg: DictConfig | Any) -> None:
     _check_node(cfg, job.JobConfig, "")
     _check_relations(cfg)
     _check_split(cfg)
+    _check_camera_extra(cfg)
+
+
+def _check_camera_extra(cfg: DictConfig) -> None:
+    """A job that renders the depth camera (``perception.source=depth``, or a planner that reads the
+    camera) needs the ``camera`` extra: one line naming the install command when it is absent."""
+    source = OmegaConf.select(cfg, "perception.source")
+    planner = OmegaConf.select(cfg, "planner.name")
+    if source == "depth":
+        why = "perception.source=depth"
+    elif get_plugin(planner).plugin.needs_observation:
+        why = f"planner={planner} (it plans on the camera's cloud)"
+    else:
+        return
+    missing = perception.missing_camera_extra()
+    if missing:
+        raise ConfigError(f"{why} needs {', '.join(missing)}, not installed: {perception.CAMERA_EXTRA}")

@@ -31,7 +31,7 @@ class FailureReason(str, enum.Enum):
 
 @dataclass
 class TrialResult:
-    """One row of the results table; also the ``graspexp.TrialResult@3`` MCAP message."""
+    """One row of the results table; also the ``graspexp.TrialResult@4`` MCAP message."""
 
     dataset: str
     object: str
@@ -63,6 +63,19 @@ class TrialResult:
     at_rest: bool = True
     """False when the settle time cap (``sim.settle_max_s``) ran out before the object came to rest: the
     planner saw a moving object (the log's ``settle_timeout`` phase says how fast it still moved)."""
+    pose_trans_err_mm: float = float("nan")
+    """``perception.source=depth``: distance between the registered and the true object origin, mm (NaN
+    when no pose was registered)."""
+    pose_rot_err_deg: float = float("nan")
+    """... angle between the registered and the true orientation, degrees."""
+    pose_adds_mm: float = float("nan")
+    """... ADD-S: mean distance from each model point at the registered pose to the nearest model point at
+    the true pose, mm (Hinterstoisser et al. 2012; symmetric objects are not penalised)."""
+    registration_fitness: float = float("nan")
+    """... share of the model points ICP aligned that found an observed point within
+    ``perception.registration.max_correspondence_m`` (Open3D's fitness), in [0, 1]."""
+    registration_cpu_s: float = float("nan")
+    """... CPU time of the registration (all threads), s."""
 
     def to_dict(self) -> dict:
         return asdict(self)

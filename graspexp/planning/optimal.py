@@ -38,13 +38,8 @@ object pose: world frame, metres):
    (``planner.grasp_point: centre``) or ``c_k`` moved along the closing axis Y to the middle of the
    section (``section_middle``; ``extras["centre_shift_m"]``), since the pads close symmetrically.
 
-``Grasp.n_feasible`` is the number of paths still ``feasible`` after step 7. ``details`` holds ``cloud``,
-``area_mask``, ``labels`` (K-means label of each area point), ``centers``, ``radii`` (m), ``main_axis``,
-``pose_axis``, ``directions`` (K, M, 3), ``feasible`` (K, M), ``costs`` (K, M; inf where infeasible),
-``section_width`` (K, M; m, nan where not examined), ``section_span`` (K, M, 2; [y_lo, y_hi] about c_k,
-m), ``contact_share`` (K, M; the smaller pad's in-area share, nan where not examined or the rule is
-off), ``best`` (k, p), ``pose``, ``width``, ``mode``, ``table_z``, ``sphere_radius`` and
-``gripper_max_width``."""
+``Grasp.n_feasible`` is the number of paths still ``feasible`` after step 7. ``details`` is an
+:class:`graspexp.planning.details.OptimalDetails` (every intermediate, with shapes and units)."""
 
 from dataclasses import dataclass, replace
 
@@ -57,6 +52,7 @@ from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_a
 from graspexp.planning.clusters import Clusters, choose_k, elongation, main_axis, max_radii_m, segment
 from graspexp.planning.collision import cloud_hits, lowest_z
 from graspexp.planning.cost import all_path_costs
+from graspexp.planning.details import OptimalDetails
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.paths import above_support, approach_directions
 from graspexp.planning.pose import grasp_rotation, grasp_rotations, opening_widths_m, slab_spans_m
@@ -144,6 +140,32 @@ def paper_candidates(req: PlanRequest, planner: str, cluster_length_m: float | N
     return Candidates(points, mask, axis, pose_axis, clusters, directions, feasible, costs)
 
 
+def paper_details(
+    req: PlanRequest, cand: Candidates, best: tuple[int, int], pose: np.ndarray, width_m: float
+) -> dict:
+    """The fields of :class:`graspexp.planning.details.PaperDetails` for the chosen path ``best`` (k, p)
+    with grasp ``pose`` (4, 4) and opening ``width_m`` (m)."""
+    return {
+        "cloud": cand.points,
+        "area_mask": cand.area_mask,
+        "labels": cand.clusters.labels,
+        "centers": cand.clusters.centers_m,
+        "radii": cand.clusters.radii_m,
+        "main_axis": cand.axis,
+        "pose_axis": cand.pose_axis,
+        "directions": cand.directions,
+        "feasible": cand.feasible,
+        "costs": cand.costs,
+        "best": np.array(best),
+        "pose": pose,
+        "width": width_m,
+        "mode": req.mode,
+        "table_z": float(req.table_z),
+        "sphere_radius": float(req.planner.sphere_radius_m),
+        "gripper_max_width": float(req.gripper.max_width_m),
+    }
+
+
 def pose_axis_source(pl, area_m: np.ndarray) -> str:
     """Which cloud's main axis the grasp frame's X follows: ``object`` or ``area`` (``planner.pose_axis``;
     ``area_if_elongated``: the area's when its :func:`.clusters.elongation` reaches
@@ -180,7 +202,7 @@ def path_costs(
 
 
 def plan_optimal(req: PlanRequest) -> PlanResult:
-    """Plan one grasp with the paper's strategy; see the module doc for the steps and ``details`` keys.
+    """Plan one grasp with the paper's strategy; see the module doc for the steps and ``details``.
 
     Raises
     ------
@@ -190,14 +212,8 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
     """
     cand = paper_candidates(req, req.planner.name)
     pl, gr = req.planner, req.gripper
-    points, mask, clusters = cand.points, cand.area_mask, cand.clusters
-    centers, radii, directions, feasible, costs = (
-        clusters.centers_m,
-        clusters.radii_m,
-        cand.directions,
-        cand.feasible,
-        cand.costs,
-    )
+    centers, radii = cand.clusters.centers_m, cand.clusters.radii_m
+    feasible, costs = cand.feasible, cand.costs  # narrowed in place below: the details' record
     k, m = costs.shape
     openings = opening_widths_m(radii, pl.width_margin, gr)  # (K,) m
     tests = PathTests.empty(k, m)
@@ -238,28 +254,12 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
             **({"n_outside_area": n_outside, "in_area_required": float(need)} if need > 0 else {}),
         },
     )
-    details = {
-        "cloud": points,
-        "area_mask": mask,
-        "labels": clusters.labels,
-        "centers": centers,
-        "radii": radii,
-        "main_axis": cand.axis,
-        "pose_axis": cand.pose_axis,
-        "directions": directions,
-        "feasible": feasible,
-        "costs": costs,
-        "section_width": section,
-        "section_span": spans,
-        "contact_share": tests.share,
-        "best": np.array([kb, pb]),
-        "pose": pose,
-        "width": np.float64(width),
-        "mode": np.str_(req.mode),
-        "table_z": np.float64(req.table_z),
-        "sphere_radius": np.float64(pl.sphere_radius_m),
-        "gripper_max_width": np.float64(gr.max_width_m),
-    }
+    details = OptimalDetails(
+        **paper_details(req, cand, (kb, pb), pose, width),
+        section_width=section,
+        section_span=spans,
+        contact_share=tests.share,
+    )
     return PlanResult(grasp=grasp, details=details)
 
 

@@ -44,12 +44,9 @@ is tried at several depths along its approach, and every try is checked as follo
 Examination stops once ``shortlist`` paths pass 1-3. ``Grasp.n_feasible`` counts them; ``extras`` holds
 ``K``, ``M``, ``n_examined``, the rejections (``n_too_wide``, ``n_below_support``, ``n_collides``,
 ``n_weak_contact``, ``n_outside_area``), ``in_area_required``, ``pad_depth_m``, ``gravity_arm_m``,
-``depth_offset_m``, ``noise_pass``, ``com_factor`` and ``edge_excess_m``. ``details`` holds the same keys as ``optimal``
-where they apply (``cloud``, ``area_mask``, ``labels``, ``centers``, ``radii``, ``main_axis``, ``directions``, ``costs`` (K, M; the
-paper's, inf where removed by the plane test), ``feasible`` (K, M), ``pose_axis``, ``best``, ``pose``, ``width``,
-``mode``, ``table_z``, ``sphere_radius``, ``gripper_max_width``) plus ``com`` (3,) and the S
-shortlisted paths' ``shortlist_poses`` (S, 4, 4), ``shortlist_widths`` (S,) m, ``shortlist_costs`` (S,, step
-4), ``shortlist_robust`` (S,) bool, ``shortlist_edge_excess_m`` (S,) and ``shortlist_pad_depth_m`` (S,)
+``depth_offset_m``, ``noise_pass``, ``com_factor`` and ``edge_excess_m``. ``details`` is an
+:class:`graspexp.planning.details.OptimalPlusDetails`: the paper's intermediates (``costs`` are the paper's,
+inf where removed by the plane test), ``com`` and the ``shortlist`` of the S passing paths
 (:mod:`graspexp.tools.bench.shortlist` simulates each of them).
 """
 
@@ -62,9 +59,10 @@ from graspexp.core.seeding import rng_for
 from graspexp.grippers import GripperGeometry
 from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
 from graspexp.planning.collision import Placement, cloud_hits, place_for_request
+from graspexp.planning.details import Candidate, OptimalPlusDetails, Shortlist
 from graspexp.planning.friction import cone_cosine
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
-from graspexp.planning.optimal import paper_candidates
+from graspexp.planning.optimal import paper_candidates, paper_details
 from graspexp.planning.pose import grasp_rotations, opening_widths_m
 from graspexp.planning.request import PlanRequest, PlanResult
 from graspexp.planning.stability import (
@@ -130,16 +128,17 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
             + no_grasp_in_area(req, best_share)
         )
     passed = passed[: pl.shortlist]
-    poses = np.stack([p[2] for p in passed])
-    widths = np.array([p[3] for p in passed])
+    poses = np.stack([c.pose for c in passed])
+    widths = np.array([c.width_m for c in passed])
     arms = gravity_arm_m(poses, com)
     factors = 1.0 + pl.com_weight * arms / size
-    costs = np.array([cand.costs[p[0], p[1]] for p in passed]) * factors
+    costs = np.array([cand.costs[c.cluster, c.path] for c in passed]) * factors
     noise_pass = _noise_pass(req, points, poses, widths, geometry, in_area_required)
     robust = noise_pass >= min(pl.noise_min_pass, noise_pass.max())
     excess = pad_edge_excess_m(points, poses, geometry, pl.edge_clearance_m)
     j = pick_shortlisted(pl.choose_by, costs, robust, excess)
-    kb, pb, pose, width, depth, offset, roll_deg = passed[j]
+    chosen = passed[j]
+    kb, pb, pose, width = chosen.cluster, chosen.path, chosen.pose, chosen.width_m
     grasp = Grasp(
         pose=pose,
         width_m=width,
@@ -154,41 +153,27 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
             "n_examined": examined,
             **rejected,
             "in_area_required": float(in_area_required),
-            "pad_depth_m": depth,
-            "depth_offset_m": offset,
-            "roll_deg": roll_deg,
+            "pad_depth_m": chosen.pad_depth_m,
+            "depth_offset_m": chosen.depth_offset_m,
+            "roll_deg": chosen.roll_deg,
             "gravity_arm_m": float(arms[j]),
             "com_factor": float(factors[j]),
             "noise_pass": float(noise_pass[j]),
             "edge_excess_m": float(excess[j]),
         },
     )
-    details = {
-        "cloud": points,
-        "area_mask": cand.area_mask,
-        "labels": cand.clusters.labels,
-        "centers": cand.clusters.centers_m,
-        "radii": cand.clusters.radii_m,
-        "main_axis": cand.axis,
-        "pose_axis": cand.pose_axis,
-        "directions": cand.directions,
-        "costs": cand.costs,
-        "feasible": cand.feasible,
-        "com": com,
-        "best": np.array([kb, pb]),
-        "pose": pose,
-        "width": np.float64(width),
-        "mode": np.str_(req.mode),
-        "table_z": np.float64(req.table_z),
-        "sphere_radius": np.float64(pl.sphere_radius_m),
-        "gripper_max_width": np.float64(gr.max_width_m),
-        "shortlist_poses": poses,
-        "shortlist_widths": widths,
-        "shortlist_costs": costs,
-        "shortlist_robust": robust,
-        "shortlist_edge_excess_m": excess,
-        "shortlist_pad_depth_m": np.array([p[4] for p in passed]),
-    }
+    details = OptimalPlusDetails(
+        **paper_details(req, cand, (kb, pb), pose, width),
+        com=com,
+        shortlist=Shortlist(
+            poses=poses,
+            widths=widths,
+            costs=costs,
+            robust=robust,
+            edge_excess_m=excess,
+            pad_depth_m=np.array([c.pad_depth_m for c in passed]),
+        ),
+    )
     return PlanResult(grasp=grasp, details=details)
 
 
@@ -281,10 +266,10 @@ class _Tries:
             )
 
 
-def _search_paths(pl, tries: _Tries, min_share: float) -> tuple[list[tuple], dict[str, int], int, float]:
+def _search_paths(pl, tries: _Tries, min_share: float) -> tuple[list[Candidate], dict[str, int], int, float]:
     """Steps 1-3 of the module doc over the paper's paths in ascending cost, in batches of
     :data:`PATH_BATCH`, requiring ``min_share`` of each pad's contact in the area: the passing paths
-    ``(k, p, pose, width, depth, offset, roll_deg)`` (up to ``shortlist``), the rejection counts, the
+    (:class:`~graspexp.planning.details.Candidate`, up to ``shortlist``), the rejection counts, the
     number of paths examined and the largest in-area share among the tries that pass everything but the
     area test (0 if none)."""
     offsets = tries.offsets
@@ -293,7 +278,7 @@ def _search_paths(pl, tries: _Tries, min_share: float) -> tuple[list[tuple], dic
     rejected = dict.fromkeys(
         ("n_too_wide", "n_below_support", "n_collides", "n_weak_contact", "n_outside_area"), 0
     )
-    passed: list[tuple] = []
+    passed: list[Candidate] = []
     examined, best_share = 0, 0.0
     for n in range(tries.n_batches):
         batch = tries.batch(n)
@@ -313,14 +298,14 @@ def _search_paths(pl, tries: _Tries, min_share: float) -> tuple[list[tuple], dic
             j = int(by_offset[int(np.argmax(score[by_offset]))])
             f = (i * n_roll + r) * n_off + j
             passed.append(
-                (
-                    int(batch.ks[i]),
-                    int(batch.ps[i]),
-                    batch.placed.poses[f],
-                    float(batch.placed.widths_m[f]),
-                    float(depth[i, r, j]),
-                    float(offsets[j]),
-                    float(pl.rolls_deg[r]),
+                Candidate(
+                    cluster=int(batch.ks[i]),
+                    path=int(batch.ps[i]),
+                    pose=batch.placed.poses[f],
+                    width_m=float(batch.placed.widths_m[f]),
+                    pad_depth_m=float(depth[i, r, j]),
+                    depth_offset_m=float(offsets[j]),
+                    roll_deg=float(pl.rolls_deg[r]),
                 )
             )
         if len(passed) >= pl.shortlist:

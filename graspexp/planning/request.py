@@ -5,6 +5,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from graspexp.config import CostConfig, GripperConfig, PlannerConfig
+from graspexp.perception.observation import Observation
+from graspexp.planning.details import PaperDetails
 from graspexp.planning.grasp import Grasp
 
 
@@ -25,6 +27,10 @@ class PlanRequest:
     support_blocks_gripper : whether the support is an obstacle for the fingers and palm
         (``mode.support_collides_with_gripper``: the bin's table is; the collaborative mode's box, removed
         after the grasp, is not). Paths through the support plane are dropped either way (III-D).
+    observation : what the simulated depth camera saw (views, observed cloud with normals and per-point
+        object ids, the target's id), when the trial rendered it (``perception.source=depth``, or a planner
+        whose schema sets ``needs_observation``); None otherwise. ``points`` and ``object_pose`` are then
+        the model placed at the registered pose (or the true one with ``perception.source=truth``).
     """
 
     points: np.ndarray
@@ -38,11 +44,19 @@ class PlanRequest:
     cost: CostConfig
     seed: int
     support_blocks_gripper: bool = True
+    observation: Observation | None = None
 
 
 @dataclass(frozen=True)
 class PlanResult:
-    """A grasp plus every intermediate a figure or test may want (keys as in ``+dump=FILE.npz``)."""
+    """A grasp plus every intermediate a figure or test may want: a typed record
+    (:mod:`graspexp.planning.details`) for the paper's planners, a dict of arrays for the others."""
 
     grasp: Grasp
-    details: dict[str, np.ndarray] = field(default_factory=dict)
+    details: PaperDetails | dict[str, np.ndarray] = field(default_factory=dict)
+
+    def detail_arrays(self) -> dict[str, np.ndarray]:
+        """The intermediates as named arrays (what ``plan --dump`` writes)."""
+        if isinstance(self.details, PaperDetails):
+            return self.details.arrays()
+        return {key: np.asarray(value) for key, value in self.details.items()}

@@ -2,9 +2,11 @@
 
 import foxglove
 from foxglove.channels import (
+    CameraCalibrationChannel,
     FrameTransformsChannel,
     PointCloudChannel,
     PoseInFrameChannel,
+    RawImageChannel,
     SceneUpdateChannel,
 )
 
@@ -34,5 +36,31 @@ class Channels:
                 context=context,
             )
             for topic, name in S.TOPIC_SCHEMAS.items()
-            if name in S.SCHEMAS
+            if name in S.SCHEMAS and topic not in S.CAMERA_TOPICS
         }
+        self._camera: CameraChannels | None = None
+
+    @property
+    def camera(self) -> "CameraChannels":
+        """The camera's channels, created on first use (a trial without a camera has none)."""
+        if self._camera is None:
+            self._camera = CameraChannels(self.context)
+        return self._camera
+
+
+class CameraChannels:
+    """The channels of :data:`graspexp.record.schemas.CAMERA_TOPICS`."""
+
+    def __init__(self, context: foxglove.Context):
+        self.depth = RawImageChannel(S.TOPIC_DEPTH, context=context)
+        self.ids = RawImageChannel(S.TOPIC_IDS, context=context)
+        self.calibration = CameraCalibrationChannel(S.TOPIC_CALIBRATION, context=context)
+        self.cloud = PointCloudChannel(S.TOPIC_CLOUD, context=context)
+        self.perception = foxglove.Channel(
+            S.TOPIC_PERCEPTION,
+            schema=foxglove.Schema(
+                name=S.PERCEPTION, encoding=S.SCHEMA_ENCODING, data=S.schema_bytes(S.PERCEPTION)
+            ),
+            message_encoding=S.MESSAGE_ENCODING,
+            context=context,
+        )

@@ -78,6 +78,9 @@ class TrialLog:
     colors, indices}])."""
     scene_deletions: list[tuple[float, str]] = field(default_factory=list)
     """(t_s, entity id) for each entity a /scene message deletes (e.g. the support when it is removed)."""
+    perception: dict | None = None
+    """The /perception message (graspexp.Perception@1) of a trial that rendered the camera, its poses as
+    (4, 4) ndarrays; None otherwise."""
 
 
 def _name(source: Any) -> str:
@@ -360,6 +363,12 @@ def read_trial(source: Path | str | IO[bytes], *, require_result: bool = True) -
                 if not isinstance(msg, dict) or "success" not in msg:
                     raise ValueError("result lacks 'success'")
                 log.result = msg
+            elif topic == S.TOPIC_PERCEPTION:
+                log.perception = {
+                    k: np.array(v, dtype=float) if k.endswith("_pose") else v
+                    for k, v in msg.items()
+                    if k != "timestamp"
+                }
             elif topic == S.TOPIC_SCENE:
                 log.scene_deletions.extend((t_s, d.id) for d in msg.deletions)
                 if msg.entities:

@@ -30,11 +30,15 @@ FRAME_TRANSFORMS = "foxglove.FrameTransforms"
 SCENE_UPDATE = "foxglove.SceneUpdate"
 POSE_IN_FRAME = "foxglove.PoseInFrame"
 POINT_CLOUD = "foxglove.PointCloud"
+RAW_IMAGE = "foxglove.RawImage"
+CAMERA_CALIBRATION = "foxglove.CameraCalibration"
+PERCEPTION = "graspexp.Perception@1"
 PLANNED_GRASP = "graspexp.PlannedGrasp@1"
 PHASE = "graspexp.Phase@1"
-TRIAL_RESULT = "graspexp.TrialResult@3"
-READABLE_RESULTS = (TRIAL_RESULT, "graspexp.TrialResult@2")
-"""/result schemas the readers accept: @2 is @3 without ``at_rest`` (then True: the cap was not checked)."""
+TRIAL_RESULT = "graspexp.TrialResult@4"
+READABLE_RESULTS = (TRIAL_RESULT, "graspexp.TrialResult@3", "graspexp.TrialResult@2")
+"""/result schemas the readers accept: @3 is @4 without the pose-registration fields (then NaN: no pose
+was registered), @2 is @3 without ``at_rest`` (then True: the cap was not checked)."""
 
 TOPIC_SCENE = "/scene"
 TOPIC_TF = "/tf"
@@ -43,6 +47,19 @@ TOPIC_CONTACTS = "/contacts"
 TOPIC_GRASP = "/grasp"
 TOPIC_PHASE = "/phase"
 TOPIC_RESULT = "/result"
+TOPIC_DEPTH = "/camera/depth"
+TOPIC_IDS = "/camera/ids"
+TOPIC_CALIBRATION = "/camera/calibration"
+TOPIC_CLOUD = "/camera/cloud"
+TOPIC_PERCEPTION = "/perception"
+CAMERA_TOPICS = (TOPIC_DEPTH, TOPIC_IDS, TOPIC_CALIBRATION, TOPIC_CLOUD, TOPIC_PERCEPTION)
+"""Topics of a trial that rendered the depth camera (created on first use: other logs lack them).
+``/camera/depth`` (32FC1, m, 0 = no return) and ``/camera/ids`` (16UC1 object ids) are one
+foxglove.RawImage per view, in the view's frame (``view0``, ...: /tf, OpenCV axes);
+``/camera/calibration`` its pinhole intrinsics; ``/camera/cloud`` the observed cloud in ``world``
+(:data:`CLOUD_FIELDS`); ``/perception`` the registered pose, its errors and the registration's fitness."""
+CLOUD_FIELDS = ("x", "y", "z", "normal_x", "normal_y", "normal_z")
+"""float32 fields of a /camera/cloud point (world m, unit normal), then ``id`` (uint32, object id)."""
 
 TOPIC_SCHEMAS: dict[str, str] = {
     TOPIC_SCENE: SCENE_UPDATE,
@@ -52,6 +69,11 @@ TOPIC_SCHEMAS: dict[str, str] = {
     TOPIC_GRASP: PLANNED_GRASP,
     TOPIC_PHASE: PHASE,
     TOPIC_RESULT: TRIAL_RESULT,
+    TOPIC_DEPTH: RAW_IMAGE,
+    TOPIC_IDS: RAW_IMAGE,
+    TOPIC_CALIBRATION: CAMERA_CALIBRATION,
+    TOPIC_CLOUD: POINT_CLOUD,
+    TOPIC_PERCEPTION: PERCEPTION,
 }
 """Topic -> schema name, one channel per topic."""
 
@@ -173,6 +195,38 @@ def _phase() -> dict:
     }
 
 
+def _perception() -> dict:
+    matrix = {
+        "type": "array",
+        "items": {"type": "array", "items": _NUMBER_OR_NAN, "minItems": 4, "maxItems": 4},
+        "minItems": 4,
+        "maxItems": 4,
+    }
+    number = dict(_NUMBER_OR_NAN)
+    return {
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": PERCEPTION,
+        "description": "What the planner was told about the object at planning time (perception.*).",
+        "type": "object",
+        "properties": {
+            "timestamp": _time("Simulation time of the camera frame"),
+            "source": {"type": "string", "description": "perception.source: truth or depth"},
+            "true_pose": {**matrix, "description": "True object pose, world, 4x4 row-major, m"},
+            "prior_pose": {**matrix, "description": "Noisy true pose (the registration's prior), m"},
+            "estimated_pose": {**matrix, "description": "Registered pose (source depth), m"},
+            "method": {"type": "string", "description": "icp or global+icp"},
+            "trans_mm": {**number, "description": "Translation error of the registered pose, mm"},
+            "rot_deg": {**number, "description": "Rotation error of the registered pose, degrees"},
+            "adds_mm": {**number, "description": "ADD-S of the registered pose, mm"},
+            "fitness": {**number, "description": "Share of model points with a correspondence"},
+            "rmse_m": {**number, "description": "RMS distance of the correspondences, m"},
+            "n_points": {"type": "integer", "minimum": 0, "description": "Observed cloud size"},
+            "n_target_points": {"type": "integer", "minimum": 0, "description": "Points on the target"},
+        },
+        "required": ["timestamp", "source", "true_pose", "prior_pose", "n_points", "n_target_points"],
+    }
+
+
 def _annotation_schema(tp: object) -> dict:
     """JSON Schema for one TrialResult field annotation."""
     if tp is bool:
@@ -213,6 +267,7 @@ SCHEMAS: dict[str, dict] = {
     PLANNED_GRASP: _planned_grasp(),
     PHASE: _phase(),
     TRIAL_RESULT: _trial_result(),
+    PERCEPTION: _perception(),
 }
 """Our own schema name -> JSON Schema document (the Foxglove topics carry protobuf schemas from the SDK)."""
 

@@ -32,6 +32,7 @@ import foxglove
 import numpy as np
 from foxglove.mcap import MCAPCompression, MCAPWriteOptions
 from foxglove.messages import (
+    CameraCalibration,
     FrameTransform,
     FrameTransforms,
     PackedElementField,
@@ -40,6 +41,7 @@ from foxglove.messages import (
     Pose,
     PoseInFrame,
     Quaternion,
+    RawImage,
     SceneEntity,
     SceneEntityDeletion,
     SceneEntityDeletionType,
@@ -68,6 +70,16 @@ _CONTACT_FIELDS = [
     for i, n in enumerate(S.CONTACT_BODIES)
 ]
 _IDENTITY = Pose(position=Vector3(), orientation=Quaternion(w=1.0))
+
+_CLOUD_DTYPE = np.dtype([(n, "<f4") for n in S.CLOUD_FIELDS] + [("id", "<u4")])
+_CLOUD_FIELDS = [
+    PackedElementField(name=n, offset=_CLOUD_DTYPE.fields[n][1], type=PackedElementFieldNumericType.Float32)
+    for n in S.CLOUD_FIELDS
+] + [
+    PackedElementField(
+        name="id", offset=_CLOUD_DTYPE.fields["id"][1], type=PackedElementFieldNumericType.Uint32
+    )
+]
 
 PARTIAL_SUFFIX = S.PARTIAL_SUFFIX
 WORLD_FRAME = "world"
@@ -131,6 +143,20 @@ def _contact_point(c: Mapping[str, Any]) -> bytes:
     except KeyError as exc:
         raise ValueError(f"contact body {exc.args[0]!r} is not one of {BODY_NAMES}") from None
     return _CONTACT.pack(*position, *normal, *force, float(c.get("separation_m", 0.0)), *bodies)
+
+
+def _raw_image(ts: Timestamp, frame_id: str, pixels: np.ndarray, encoding: str) -> RawImage:
+    """A foxglove.RawImage of a (H, W) little-endian array."""
+    h, w = pixels.shape
+    return RawImage(
+        timestamp=ts,
+        frame_id=frame_id,
+        width=w,
+        height=h,
+        encoding=encoding,
+        step=w * pixels.dtype.itemsize,
+        data=np.ascontiguousarray(pixels).tobytes(),
+    )
 
 
 def _dumps(message: Any) -> bytes:
@@ -278,7 +304,7 @@ class TrialWriter:
         self._json(S.TOPIC_PHASE, t_s, to_json_value(msg))
 
     def result(self, t_s: float, result: Mapping[str, Any] | Any) -> None:
-        """/result, graspexp.TrialResult@3: ``TrialResult.to_dict()`` (a TrialResult is accepted too).
+        """/result, graspexp.TrialResult@4: ``TrialResult.to_dict()`` (a TrialResult is accepted too).
 
         NaN floats are written as null and read back as NaN.
         """
@@ -290,6 +316,66 @@ class TrialWriter:
             self._mcap.flush()  # the result gets a chunk of its own: read_result decompresses only that
         self._json(S.TOPIC_RESULT, t_s, to_json_value(d))
         self._has_result = True
+
+    def perception(
+        self, t_s: float, observation: Any, poses: Mapping[str, np.ndarray], info: Mapping[str, Any]
+    ) -> None:
+        """What the camera saw at planning time: per view (a :class:`graspexp.perception.CameraView` of
+        ``observation``) /camera/depth, /camera/ids and /camera/calibration in the view's frame (the trial
+        puts the views' and the object's frames on /tf); the observed cloud on /camera/cloud; ``poses``
+        (``object_true``, ``object_prior``, ``object_estimated``: (4, 4) world) and ``info`` (source,
+        errors, fitness, ...) on /perception (graspexp.Perception@1)."""
+        ns = self._ns(t_s)
+        ts = Timestamp(*divmod(ns, 1_000_000_000))
+        ch = self._ch.camera
+        for v in observation.views:
+            h, w = v.depth.shape
+            ch.depth.log(_raw_image(ts, v.name, v.depth.astype("<f4"), "32FC1"), log_time=ns)
+            ids = np.clip(v.ids, 0, 65535).astype("<u2")
+            ch.ids.log(_raw_image(ts, v.name, ids, "16UC1"), log_time=ns)
+            K = [float(x) for x in np.asarray(v.K, dtype=float).ravel()]
+            P = [K[0], K[1], K[2], 0.0, K[3], K[4], K[5], 0.0, K[6], K[7], K[8], 0.0]
+            ch.calibration.log(
+                CameraCalibration(
+                    timestamp=ts,
+                    frame_id=v.name,
+                    width=w,
+                    height=h,
+                    distortion_model="plumb_bob",
+                    D=[0.0] * 5,
+                    K=K,
+                    R=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+                    P=P,
+                ),
+                log_time=ns,
+            )
+        packed = np.zeros(len(observation.points), dtype=_CLOUD_DTYPE)
+        for i, name in enumerate(S.CLOUD_FIELDS):
+            packed[name] = (observation.points if i < 3 else observation.normals)[:, i % 3]
+        packed["id"] = observation.point_ids
+        ch.cloud.log(
+            PointCloud(
+                timestamp=ts,
+                frame_id=WORLD_FRAME,
+                pose=_IDENTITY,
+                point_stride=_CLOUD_DTYPE.itemsize,
+                fields=_CLOUD_FIELDS,
+                data=packed.tobytes(),
+            ),
+            log_time=ns,
+        )
+        target = int((observation.point_ids == observation.target_id).sum())
+        msg = {
+            "timestamp": stamp(t_s),
+            **{k: v for k, v in info.items() if k != "estimated_pose"},
+            "true_pose": np.asarray(poses["object_true"]),
+            "prior_pose": np.asarray(poses["object_prior"]),
+            "n_points": len(observation.points),
+            "n_target_points": target,
+        }
+        if "estimated_pose" in info:
+            msg["estimated_pose"] = np.asarray(info["estimated_pose"])
+        ch.perception.log(_dumps(to_json_value(msg)), log_time=ns)
 
     def finish(self) -> None:
         """Write the summary and footer. The stream is flushed, not closed."""

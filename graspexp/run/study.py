@@ -15,7 +15,7 @@ the sweeper has a ``storage``:
   ``hydra.sweeper.n_trials`` finished trials (counted over the whole study: a finished study runs nothing;
   raise ``n_trials`` to extend it), with the sampler's seed moved on by the number of trials so far (a
   seeded sampler would otherwise draw the first run's parameters again);
-- after the sweep, it writes the study's history (:data:`TRIALS_CSV`, one row per trial) and its plots
+- after the sweep, it writes the study's history (:data:`graspexp.report.study.TRIALS_CSV`, one row per trial) and its plots
   (:func:`graspexp.report.study.plot_study`) into the sweep directory.
 """
 
@@ -28,18 +28,6 @@ from typing import Any
 
 from hydra.experimental.callback import Callback
 from omegaconf import DictConfig, OmegaConf, read_write
-
-from graspexp.report.study import (
-    FINISHED_STATES,
-    TRIALS_CSV,
-    load_study,
-    plot_study,
-    recorded_overrides,
-    searched_keys,
-    sqlite_path,
-    study_table,
-    write_study_record,
-)
 
 log = logging.getLogger(__name__)
 INTERRUPTED = "graspexp_interrupted"
@@ -65,6 +53,14 @@ class OptunaStudy(Callback):
         storage = OmegaConf.select(sweeper, "storage", default=None)
         if not storage:
             return
+        from graspexp.report.study import (  # here, not at the top: every job instantiates this callback
+            FINISHED_STATES,
+            recorded_overrides,
+            searched_keys,
+            sqlite_path,
+            write_study_record,
+        )
+
         overrides = [str(o) for o in config.hydra.overrides.task]
         recorded = recorded_overrides(Path(config.hydra.sweep.dir))
         if recorded is not None:
@@ -122,6 +118,8 @@ class OptunaStudy(Callback):
         storage = OmegaConf.select(sweeper, "storage", default=None)
         if not storage:
             return
+        from graspexp.report.study import TRIALS_CSV, load_study, plot_study, study_table
+
         study = load_study(str(storage), str(sweeper.study_name))
         sweep_dir = Path(config.hydra.sweep.dir)
         table = study_table(study)

@@ -19,15 +19,22 @@ from omegaconf import DictConfig, OmegaConf
 
 from graspexp.config import JobConfig
 from graspexp.core.bodies import FINGER_NAMES, SUPPORT_NAME
-from graspexp.core.geometry import make_pose, random_rotation, transform_points, yaw_rotation
+from graspexp.core.geometry import (
+    make_pose,
+    matrix_to_quat_wxyz,
+    random_rotation,
+    transform_points,
+    yaw_rotation,
+)
 from graspexp.core.outcome import FailureReason, TrialResult
 from graspexp.core.seeding import plan_seed, rng_for
 from graspexp.datasets.model import ObjectModel
+from graspexp.perception import Observation
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.request import PlanRequest, PlanResult
-from graspexp.planning.stability import pose_error
 from graspexp.sim.contacts import SupportTouch, contact_records, finger_forces
 from graspexp.sim.gripper import Gripper, build_gripper
+from graspexp.sim.perceive import Perceived, perceive
 from graspexp.sim.scene import TrialScene, build_scene
 
 
@@ -54,6 +61,9 @@ class LogSink(Protocol):
     def grasp(self, t_s: float, grasp: Mapping[str, Any]) -> None: ...
     def phase(self, t_s: float, name: str, info: Mapping[str, Any] | None = None) -> None: ...
     def result(self, t_s: float, result: Mapping[str, Any]) -> None: ...
+    def perception(
+        self, t_s: float, observation: Observation, poses: Mapping[str, np.ndarray], info: Mapping[str, Any]
+    ) -> None: ...
 
 
 class NullRecorder:
@@ -81,6 +91,11 @@ class NullRecorder:
         pass
 
     def result(self, t_s: float, result: Mapping[str, Any]) -> None:
+        pass
+
+    def perception(
+        self, t_s: float, observation: Observation, poses: Mapping[str, np.ndarray], info: Mapping[str, Any]
+    ) -> None:
         pass
 
 
@@ -126,20 +141,6 @@ def drop_pose(
     lo, hi = v.min(axis=0), v.max(axis=0)
     t = np.array([-(lo[0] + hi[0]) / 2, -(lo[1] + hi[1]) / 2, table_z + gap_m - lo[2]])
     return make_pose(R, t)
-
-
-def perceived_pose(
-    true_pose: np.ndarray, trans_mm: float, rot_deg: float, rng: np.random.Generator
-) -> np.ndarray:
-    """The pose the planner sees: Gaussian translation (std ``trans_mm``) and a rotation about a random axis
-    by a Gaussian angle (std ``rot_deg``) about the object's origin. Zero noise returns the pose unchanged."""
-    if trans_mm == 0 and rot_deg == 0:
-        return true_pose.copy()
-    dR, trans = pose_error(rng, trans_mm, rot_deg)
-    out = true_pose.copy()
-    out[:3, :3] = dR @ true_pose[:3, :3]
-    out[:3, 3] += trans
-    return out
 
 
 F32_DOT_REL_ERROR = 1e-6
@@ -377,7 +378,7 @@ def run_trial(ctx: TrialContext) -> TrialResult:
     try:
         sim = _drop_until_on_support(ctx, res, timings)
         with sim.timed("plan"):
-            grasp = _plan(ctx, sim)
+            grasp = _plan(ctx, sim, res)
         res.grasp_cost, res.grasp_width_m, res.n_feasible = grasp.cost, grasp.width_m, grasp.n_feasible
         with sim.timed("quality"):
             res.fc_min_mu = _force_closure_mu(ctx, sim, grasp)
@@ -430,17 +431,17 @@ def _drop_until_on_support(ctx: TrialContext, res: TrialResult, timings: dict) -
     raise TrialFailed(FailureReason.FELL_OFF_SUPPORT, f"{cfg.sim.max_redrops + 1} drops fell off the support")
 
 
-def _plan(ctx: TrialContext, sim: _Sim) -> Grasp:
+def _plan(ctx: TrialContext, sim: _Sim, res: TrialResult) -> Grasp:
     cfg = ctx.cfg
-    noise = cfg.perception.noise
-    seen = perceived_pose(
-        sim.ts.object_pose(), noise.trans_mm, noise.rot_deg, rng_for(ctx.trial_seed, "noise")
-    )
+    true_pose = sim.ts.object_pose()
+    seen = perceive(cfg, ctx.model, true_pose, sim.ts.table_z, ctx.trial_seed)
+    if seen.observation is not None:
+        _record_perception(ctx, sim, res, seen, true_pose)
     req = PlanRequest(
-        points=transform_points(seen, ctx.model.points),
-        normals=ctx.model.normals @ seen[:3, :3].T,
+        points=transform_points(seen.pose, ctx.model.points),
+        normals=ctx.model.normals @ seen.pose[:3, :3].T,
         area_mask=ctx.model.area_mask,
-        object_pose=seen,
+        object_pose=seen.pose,
         table_z=sim.ts.table_z,
         mode=cfg.mode.name,
         gripper=cfg.gripper,
@@ -448,6 +449,7 @@ def _plan(ctx: TrialContext, sim: _Sim) -> Grasp:
         cost=cfg.cost,
         seed=plan_seed(ctx.trial_seed),
         support_blocks_gripper=bool(cfg.mode.support_collides_with_gripper),
+        observation=seen.observation,
     )
     try:
         grasp = ctx.plan(req).grasp
@@ -456,6 +458,31 @@ def _plan(ctx: TrialContext, sim: _Sim) -> Grasp:
     sim.phase("plan")
     ctx.recorder.grasp(sim.log_t, _grasp_record(grasp))
     return grasp
+
+
+def _record_perception(
+    ctx: TrialContext, sim: _Sim, res: TrialResult, seen: Perceived, true_pose: np.ndarray
+) -> None:
+    """The camera's frames, cloud and poses into the log; the pose errors and timings into the result."""
+    reg = seen.registration
+    if reg is not None:
+        res.pose_trans_err_mm = seen.errors["trans_mm"]
+        res.pose_rot_err_deg = seen.errors["rot_deg"]
+        res.pose_adds_mm = seen.errors["adds_mm"]
+        res.registration_fitness = reg.fitness
+        res.registration_cpu_s = reg.cpu_s
+    if sim.recording:
+        poses = {"object_true": true_pose, "object_prior": seen.prior}
+        if reg is not None:
+            poses["object_estimated"] = reg.pose
+        info = {"source": ctx.cfg.perception.source, **seen.errors}
+        if reg is not None:
+            info.update(method=reg.method, fitness=reg.fitness, rmse_m=reg.rmse_m, estimated_pose=reg.pose)
+        frames = {v.name: v.world_from_camera for v in seen.observation.views} | poses
+        sim.rec.transforms(
+            sim.log_t, {k: (T[:3, 3], matrix_to_quat_wxyz(T[:3, :3])) for k, T in frames.items()}
+        )
+        ctx.recorder.perception(sim.log_t, seen.observation, poses, info)
 
 
 def _force_closure_mu(ctx: TrialContext, sim: _Sim, grasp: Grasp) -> float:

@@ -22,5 +22,6 @@ TOOLS: tuple[str, ...] = (
     "bench.shortlist",
     "bench.compare_runs",
     "bench.plan_grasps",
+    "bench.registration",
 )
 """Every tool: ``python -m graspexp NAME`` runs ``graspexp.tools.NAME.main``."""

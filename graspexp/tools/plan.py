@@ -57,7 +57,7 @@ def grasp_record(cfg: DictConfig, planned: PlannedObject) -> dict:
 
 def dump(path: str, planned: PlannedObject) -> None:
     """Save every intermediate of the plan to ``path`` (``.npz``)."""
-    arrays = {key: np.asarray(value) for key, value in planned.result.details.items()}
+    arrays = planned.result.detail_arrays()
     arrays["object_pose"] = planned.object_pose
     write_atomic(Path(path), lambda fh: np.savez(fh, **arrays))
 

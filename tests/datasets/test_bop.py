@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
-from conftest import compose_cfg
+from helpers.config import compose_cfg
 
 from graspexp.datasets import DatasetError, ObjectError, catalogue, load_object
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import trimesh
 import yaml
-from conftest import compose_cfg
+from helpers.config import compose_cfg
 from omegaconf import OmegaConf
 
 from graspexp.config import DatasetConfig

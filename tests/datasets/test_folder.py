@@ -5,7 +5,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import trimesh
-from conftest import compose_cfg, make_object_folder
+from helpers.config import compose_cfg
+from helpers.objects import make_object_folder
 
 from graspexp.datasets import DatasetError, ObjectError, catalogue, load_object, select_objects
 

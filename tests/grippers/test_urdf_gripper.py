@@ -6,7 +6,8 @@ import io
 import re
 
 import pytest
-from conftest import compose_cfg, write_urdf_gripper
+from helpers.config import compose_cfg
+from helpers.objects import write_urdf_gripper
 from omegaconf import OmegaConf
 
 from graspexp.config import ConfigError, validate

@@ -4,10 +4,14 @@ and one primitive, the shared finger/palm collision checks, determinism and NoFe
 import numpy as np
 import pytest
 import trimesh
-from omegaconf import OmegaConf
-from test_planner_common import RG2  # explicit RG2 dimensions, independent of conf/gripper
+from helpers.planning import (  # RG2: explicit dimensions, independent of conf/gripper
+    RG2,
+    TABLE_Z,
+    full_view,
+    plain_cfg,
+    resting_cloud,
+)
 
-from graspexp.config.compose import compose_config
 from graspexp.config.plugins import LoadedPlanner, load_planners
 from graspexp.grippers import GripperGeometry
 from graspexp.planning import Grasp, NoFeasibleGrasp, PlanRequest, get_planner, plan
@@ -17,24 +21,24 @@ from graspexp.planning.stability import pad_contacts
 
 PLANNERS = tuple(sorted(n for n, p in load_planners().items() if isinstance(p, LoadedPlanner)))
 """Every registered planner that loads: the contract tests run over each."""
-TABLE_Z = 0.1
-
-
-def _cfg(planner: str, mode: str = "bin", *extra: str):
-    return OmegaConf.to_object(compose_config([f"planner={planner}", f"mode={mode}", *extra]))
-
-
-def _cloud(mesh: trimesh.Trimesh, n: int = 768, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """Surface samples resting on the table (lowest point at TABLE_Z) and their outward normals."""
-    pts, faces = trimesh.sample.sample_surface_even(mesh, n, seed=seed)
-    pts = pts + np.array([0.0, 0.0, TABLE_Z - mesh.bounds[0, 2]])
-    return pts, mesh.face_normals[faces]
 
 
 def _request(planner: str, pts, normals, mode: str = "bin", seed: int = 3, area=None) -> PlanRequest:
-    cfg = _cfg(planner, mode)
+    cfg = plain_cfg(planner, mode)
     mask = np.ones(len(pts), bool) if area is None else area
-    return PlanRequest(pts, normals, mask, np.eye(4), TABLE_Z, mode, cfg.gripper, cfg.planner, cfg.cost, seed)
+    return PlanRequest(
+        pts,
+        normals,
+        mask,
+        np.eye(4),
+        TABLE_Z,
+        mode,
+        cfg.gripper,
+        cfg.planner,
+        cfg.cost,
+        seed,
+        observation=full_view(pts, normals),
+    )
 
 
 def _shapes() -> dict[str, trimesh.Trimesh]:
@@ -76,7 +80,7 @@ def _check_contract(req: PlanRequest, name: str) -> None:
     ("shape", "mode"), [("box", "bin"), ("cylinder", "collab"), ("flat", "bin"), ("tilted", "collab")]
 )
 def test_contract_on_synthetic_clouds(name: str, shape: str, mode: str) -> None:
-    pts, normals = _cloud(_shapes()[shape])
+    pts, normals = resting_cloud(_shapes()[shape])
     try:
         _check_contract(_request(name, pts, normals, mode), name)
     except NoFeasibleGrasp as exc:  # a refusal names the planner and its reason in one line
@@ -89,7 +93,7 @@ def test_contract_on_synthetic_clouds(name: str, shape: str, mode: str) -> None:
 def test_contract_on_a_primitive(name: str) -> None:
     from graspexp.datasets import load_object
 
-    cfg = _cfg(name, "bin", "dataset=primitives")
+    cfg = plain_cfg(name, "bin", "dataset=primitives")
     model = load_object(cfg.dataset, "mug", 1024, 0)
     pose = np.eye(4)
     pose[:3, :3] = trimesh.transformations.rotation_matrix(1.1, [0.3, 1, 0.2])[:3, :3]
@@ -106,13 +110,14 @@ def test_contract_on_a_primitive(name: str) -> None:
         cfg.planner,
         cfg.cost,
         11,
+        observation=full_view(pts + pose[:3, 3], model.normals @ pose[:3, :3].T),
     )
     _check_contract(req, name)
 
 
 @pytest.mark.parametrize("name", PLANNERS)
 def test_deterministic_given_the_seed(name: str) -> None:
-    pts, normals = _cloud(_shapes()["tilted"])
+    pts, normals = resting_cloud(_shapes()["tilted"])
     a = plan(_request(name, pts, normals, seed=5)).grasp
     b = plan(_request(name, pts, normals, seed=5)).grasp
     np.testing.assert_array_equal(a.pose, b.pose)
@@ -120,7 +125,7 @@ def test_deterministic_given_the_seed(name: str) -> None:
 
 
 def test_random_depends_on_the_seed() -> None:
-    pts, normals = _cloud(_shapes()["box"])
+    pts, normals = resting_cloud(_shapes()["box"])
     poses = {plan(_request("random", pts, normals, seed=s)).grasp.pose.tobytes() for s in range(4)}
     assert len(poses) == 4
 
@@ -128,33 +133,34 @@ def test_random_depends_on_the_seed() -> None:
 @pytest.mark.parametrize("name", ["antipodal", "obb", "optimal_plus"])
 def test_object_wider_than_the_stroke_is_infeasible(name: str) -> None:
     # a sphere, not a box: a box's corner can be pinched between fingers whose tips reach past the point
-    pts, normals = _cloud(trimesh.creation.icosphere(subdivisions=3, radius=0.15))
+    pts, normals = resting_cloud(trimesh.creation.icosphere(subdivisions=3, radius=0.15))
     with pytest.raises(NoFeasibleGrasp, match=name.split("_")[0]):
         plan(_request(name, pts, normals))
 
 
 def test_random_with_empty_area_is_infeasible() -> None:
-    pts, normals = _cloud(_shapes()["box"])
+    pts, normals = resting_cloud(_shapes()["box"])
     with pytest.raises(NoFeasibleGrasp, match="area is empty"):
         plan(_request("random", pts, normals, area=np.zeros(len(pts), bool)))
 
 
 def test_antipodal_closes_across_opposite_faces() -> None:
-    pts, normals = _cloud(_shapes()["box"], n=2048)
+    pts, normals = resting_cloud(_shapes()["box"], n=2048)
     g = plan(_request("antipodal", pts, normals)).grasp
     y = g.pose[:3, 1]
     assert np.max(np.abs(y)) == pytest.approx(1.0, abs=0.03)  # along a face normal of the axis box
     assert g.extras["pair_angle_deg"] < 10.0
     assert g.approach[2] < -0.9  # top-down preferred on a box standing on the table
     assert (
-        cloud_hits(pts, g.pose[None], _cfg("antipodal").gripper, g.width_m, sweep_m=0.1, margin_m=0.0)[0] == 0
+        cloud_hits(pts, g.pose[None], plain_cfg("antipodal").gripper, g.width_m, sweep_m=0.1, margin_m=0.0)[0]
+        == 0
     )
 
 
 def test_obb_closes_across_the_narrow_side_from_above() -> None:
     box = trimesh.creation.box((0.09, 0.05, 0.06))
     box.apply_transform(trimesh.transformations.rotation_matrix(0.6, [0, 0, 1]))
-    pts, normals = _cloud(box)
+    pts, normals = resting_cloud(box)
     g = plan(_request("obb", pts, normals)).grasp
     np.testing.assert_allclose(g.approach, [0, 0, -1], atol=1e-9)
     narrow = np.array([-np.sin(0.6), np.cos(0.6), 0.0])
@@ -163,7 +169,7 @@ def test_obb_closes_across_the_narrow_side_from_above() -> None:
 
 
 def _plan_with(name: str, pts, normals, area, seed: int = 1, *extra: str) -> Grasp:
-    c = _cfg(name, "bin", *extra)
+    c = plain_cfg(name, "bin", *extra)
     return plan(
         PlanRequest(pts, normals, area, np.eye(4), TABLE_Z, "bin", RG2, c.planner, c.cost, seed)
     ).grasp
@@ -184,7 +190,7 @@ def test_the_swept_check_keeps_the_palm_out_of_the_object() -> None:
     # A can (r 33 mm, 100 mm tall) whose grasping area is its lower 60 mm: depending on the K-means seed the
     # paper's planner without the checks grasps the area's centre nearly straight from above, with the palm inside
     # the can.
-    pts, normals = _cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
+    pts, normals = resting_cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
     area = pts[:, 2] < TABLE_Z + 0.06
     hits = {name: [] for name in PAPER_SWEEP_VARIANTS}
     for seed in range(8):
@@ -199,7 +205,7 @@ def test_the_swept_check_keeps_the_fingers_out_of_the_table() -> None:
     # The same can, whole surface as area, cut into clusters half a stroke long (K = 2): on some K-means
     # seeds the paper's planner without the checks closes from the side on the lower cluster so low that the lower
     # finger corner dips below the table top (only its sphere point is tested).
-    pts, normals = _cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
+    pts, normals = resting_cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
     area = np.ones(len(pts), bool)
     low = {name: [] for name in PAPER_SWEEP_VARIANTS}
     half = ("planner.auto_k_stroke_fraction=0.5", "planner.cluster_radius=rms")
@@ -219,7 +225,7 @@ def _pad_share(pts, normals, area, g: Grasp) -> float:
 def test_the_area_rule_keeps_the_paper_planners_pads_in_the_area() -> None:
     # The can with its lower 60 mm as the area, swept check off to isolate the rule: without it the pads
     # of some grasps reach the can's upper part, with it every grasp's pad contacts are area points.
-    pts, normals = _cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
+    pts, normals = resting_cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
     area = pts[:, 2] < TABLE_Z + 0.06
     shares = {"off": [], "on": []}
     for seed in range(8):
@@ -242,7 +248,7 @@ def test_the_area_rule_keeps_the_paper_planners_pads_in_the_area() -> None:
 
 def test_optimal_in_area_grasps_outside_the_area_only_through_the_fallback() -> None:
     # A 4 mm high ring at the can's base as the area: every pad touching it also touches the wall above.
-    pts, normals = _cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
+    pts, normals = resting_cloud(trimesh.creation.cylinder(radius=0.033, height=0.1), n=2048)
     area = pts[:, 2] < TABLE_Z + 0.004
     with pytest.raises(NoFeasibleGrasp, match=r"has less than 1.0 of a pad's contact in the grasping area"):
         _plan_with("optimal_in_area", pts, normals, area, 1, "planner.swept_check=false")
@@ -260,7 +266,7 @@ def test_optimal_in_area_grasps_outside_the_area_only_through_the_fallback() -> 
 
 
 def test_cloud_hits_counts_points_in_fingers_and_palm_only() -> None:
-    gr = _cfg("obb").gripper
+    gr = plain_cfg("obb").gripper
     pose = frame_from_axes([0, 0, -1], [0, 1, 0], [0, 0, 0.2])
     root, w = gr.tcp_from_tip_m - gr.finger_length_m, 0.06  # palm face z in the grasp frame
     local = np.array(
@@ -279,7 +285,7 @@ def test_cloud_hits_counts_points_in_fingers_and_palm_only() -> None:
 
 
 def test_lowest_z_of_a_top_down_grasp_is_the_fingertip() -> None:
-    gr = _cfg("obb").gripper
+    gr = plain_cfg("obb").gripper
     pose = frame_from_axes([0, 0, -1], [0, 1, 0], [0, 0, 0.2])
     assert lowest_z(pose[None], gr, 0.05, 0.1)[0] == pytest.approx(0.2 - gr.tcp_from_tip_m)
     boxes = GripperGeometry.of(gr).boxes(0.05)
@@ -289,11 +295,11 @@ def test_lowest_z_of_a_top_down_grasp_is_the_fingertip() -> None:
 def test_every_planner_is_registered_and_composes() -> None:
     for name in PLANNERS:
         assert get_planner(name).__name__.startswith("plan_")
-        assert _cfg(name).planner.name == name
+        assert plain_cfg(name).planner.name == name
 
 
 def test_antipodal_area_keeps_both_contacts_in_the_area() -> None:
-    pts, normals = _cloud(_shapes()["box"], n=1500)
+    pts, normals = resting_cloud(_shapes()["box"], n=1500)
     area = pts[:, 0] > 0.0  # half the box: a contact pair across x would leave it
     mask = np.zeros(len(pts), bool)
     mask[area] = True
@@ -309,7 +315,7 @@ def test_antipodal_area_keeps_both_contacts_in_the_area() -> None:
 def test_antipodal_area_pads_keeps_the_pads_in_the_area() -> None:
     """A band narrower than a pad: the sampled contacts lie in it, the pads cannot."""
     box = trimesh.creation.box((0.09, 0.06, 0.04))
-    pts, normals = _cloud(box, n=3000)
+    pts, normals = resting_cloud(box, n=3000)
     band = np.abs(pts[:, 0]) < 0.004
     loose = plan(_request("antipodal_area", pts, normals, area=band)).grasp
     assert "in_area_required" not in loose.extras  # contacts sampled in the band, pads not checked

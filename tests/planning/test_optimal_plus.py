@@ -6,7 +6,7 @@ import dataclasses
 import numpy as np
 import pytest
 import trimesh
-from test_baselines import TABLE_Z, _cfg, _cloud
+from helpers.planning import TABLE_Z, plain_cfg, resting_cloud
 
 from graspexp.core.geometry import make_pose, random_rotation
 from graspexp.grippers import GripperGeometry
@@ -21,14 +21,14 @@ from graspexp.planning.stability import (
 
 
 def _request(pts, normals, area=None, seed: int = 3, mode: str = "bin", **planner) -> PlanRequest:
-    cfg = _cfg("optimal_plus")
+    cfg = plain_cfg("optimal_plus")
     pl = dataclasses.replace(cfg.planner, **planner)
     mask = np.ones(len(pts), bool) if area is None else area
     return PlanRequest(pts, normals, mask, np.eye(4), TABLE_Z, mode, cfg.gripper, pl, cfg.cost, seed)
 
 
 def _geometry() -> GripperGeometry:
-    return GripperGeometry.of(_cfg("optimal_plus").gripper)
+    return GripperGeometry.of(plain_cfg("optimal_plus").gripper)
 
 
 def test_volume_centroid_is_the_solid_centroid_not_the_surface_mean() -> None:
@@ -96,7 +96,7 @@ def _tee() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     stem.apply_translation([0.0, -0.1, 0.0])  # y from -0.18 to -0.02, where the bar starts
     bar = trimesh.creation.box((0.2, 0.04, 0.04))
     tee = trimesh.util.concatenate([stem, bar])  # touching, not overlapping: no boolean engine needed
-    pts, normals = _cloud(tee, n=3000)
+    pts, normals = resting_cloud(tee, n=3000)
     area = pts[:, 1] > -0.021
     return pts, normals, area
 
@@ -121,7 +121,7 @@ def test_finger_width_clusters_reach_the_ends_of_a_long_area() -> None:
 
 def test_min_pad_depth_rejects_fingertip_grasps() -> None:
     flat = trimesh.creation.box((0.09, 0.06, 0.03))  # 3 cm high on the table: the pads reach 2.8 cm of it
-    pts, normals = _cloud(flat, n=2000)
+    pts, normals = resting_cloud(flat, n=2000)
     g = plan(_request(pts, normals)).grasp
     assert g.extras["pad_depth_m"] >= 0.005
     with pytest.raises(NoFeasibleGrasp, match="pad contact shallower than 0.09 m"):
@@ -130,7 +130,7 @@ def test_min_pad_depth_rejects_fingertip_grasps() -> None:
 
 def test_depth_offsets_move_the_grasp_towards_the_target_depth() -> None:
     box = trimesh.creation.box((0.05, 0.05, 0.1))
-    pts, normals = _cloud(box, n=2000)
+    pts, normals = resting_cloud(box, n=2000)
     depth = {
         t: plan(_request(pts, normals, pad_depth_target_m=t, choose_by="cost")).grasp.extras["pad_depth_m"]
         for t in (0.012, 0.045)
@@ -150,7 +150,7 @@ def test_com_weight_prefers_grasps_near_the_centre_of_mass() -> None:
     head = trimesh.creation.box((0.04, 0.09, 0.06))
     head.apply_translation([0.14, 0.0, 0.015])  # x from 0.12, where the handle ends
     hammer = trimesh.util.concatenate([handle, head])
-    pts, normals = _cloud(hammer, n=3000)
+    pts, normals = resting_cloud(hammer, n=3000)
     area = pts[:, 0] < 0.11
     arms = {
         w: plan(_request(pts, normals, area, com_weight=w, choose_by="cost")).grasp.extras["gravity_arm_m"]
@@ -196,7 +196,7 @@ def test_choose_by_edge_clearance_takes_the_grasp_whose_pads_not_edges_meet_the_
     for _ in range(5):
         turned = cone.copy()
         turned.apply_transform(make_pose(random_rotation(rng), np.zeros(3)))
-        pts, normals = _cloud(turned, n=3000)
+        pts, normals = resting_cloud(turned, n=3000)
         by_cost.append(plan(_request(pts, normals, choose_by="cost")).grasp.extras["edge_excess_m"])
         by_edges.append(plan(_request(pts, normals)).grasp.extras["edge_excess_m"])
     assert all(e <= max(c, 0.0) + 1e-12 for c, e in zip(by_cost, by_edges, strict=True))
@@ -205,7 +205,7 @@ def test_choose_by_edge_clearance_takes_the_grasp_whose_pads_not_edges_meet_the_
 
 
 def test_opening_cluster_is_at_least_the_papers_opening() -> None:
-    pts, normals = _cloud(trimesh.creation.cylinder(radius=0.02, height=0.1), n=2000)
+    pts, normals = resting_cloud(trimesh.creation.cylinder(radius=0.02, height=0.1), n=2000)
     section = plan(_request(pts, normals)).grasp
     cluster = plan(_request(pts, normals, opening="cluster")).grasp
     assert section.width_m == pytest.approx(0.04 + 2 * 0.005, abs=0.004)
@@ -213,7 +213,7 @@ def test_opening_cluster_is_at_least_the_papers_opening() -> None:
 
 
 def test_noise_check_prefers_grasps_that_survive_the_pose_error() -> None:
-    pts, normals = _cloud(trimesh.creation.box((0.05, 0.08, 0.1)), n=2000)
+    pts, normals = resting_cloud(trimesh.creation.box((0.05, 0.08, 0.1)), n=2000)
     off = plan(_request(pts, normals, noise_samples=0)).grasp
     assert off.extras["noise_pass"] == 1.0
     tight = plan(_request(pts, normals, width_clearance_m=0.0025, noise_trans_mm=4.0, noise_samples=16)).grasp
@@ -223,7 +223,7 @@ def test_noise_check_prefers_grasps_that_survive_the_pose_error() -> None:
 
 @pytest.mark.parametrize("key", ["depth_offsets_m", "rolls_deg"])
 def test_empty_lists_are_one_clear_error(key: str) -> None:
-    pts, normals = _cloud(trimesh.creation.box((0.05, 0.05, 0.05)), n=500)
+    pts, normals = resting_cloud(trimesh.creation.box((0.05, 0.05, 0.05)), n=500)
     with pytest.raises(ValueError, match=f"planner.{key} is empty: give at least one value"):
         plan(_request(pts, normals, **{key: []}))
 
@@ -232,7 +232,7 @@ def test_area_fallback_takes_the_grasp_touching_the_area_most() -> None:
     """A band of the box narrower than a pad is its area: no pad lies wholly in it, so only the fallback
     plans, and it requires the best share any try reached."""
     box = trimesh.creation.box((0.09, 0.06, 0.04))
-    pts, normals = _cloud(box, n=3000)
+    pts, normals = resting_cloud(box, n=3000)
     area = np.abs(pts[:, 0]) < 0.004
     with pytest.raises(NoFeasibleGrasp, match="in the grasping area") as strict:
         plan(_request(pts, normals, area, fallback_contacts_in_area=1.0))

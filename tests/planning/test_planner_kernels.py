@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 import pytest
-from test_planner_common import RG2, UPRIGHT_SUPPORT_Z, upright_request
+from helpers.planning import RG2, UPRIGHT_SUPPORT_Z, upright_request
 
 import graspexp.planning.optimal as optimal
 from graspexp.config import CostConfig, DatasetConfig, OptimalConfig
@@ -256,16 +256,16 @@ def test_compiled_plan_matches_the_numpy_reference_on_every_real_object(data_roo
                 continue
             ref = reference_plan(req, monkeypatch)
             compared += 1
-            np.testing.assert_array_equal(got.details["labels"], ref.details["labels"], err_msg=what)
+            np.testing.assert_array_equal(got.details.labels, ref.details.labels, err_msg=what)
             assert (got.grasp.cluster, got.grasp.path) == (ref.grasp.cluster, ref.grasp.path), what
             assert got.grasp.n_feasible == ref.grasp.n_feasible, what
             assert got.grasp.width_m == pytest.approx(ref.grasp.width_m, rel=1e-9), what
             np.testing.assert_allclose(got.grasp.pose, ref.grasp.pose, atol=1e-9, err_msg=what)
             np.testing.assert_array_equal(
-                np.isfinite(got.details["costs"]), np.isfinite(ref.details["costs"]), err_msg=what
+                np.isfinite(got.details.costs), np.isfinite(ref.details.costs), err_msg=what
             )
-            finite = np.isfinite(ref.details["costs"])
+            finite = np.isfinite(ref.details.costs)
             np.testing.assert_allclose(
-                got.details["costs"][finite], ref.details["costs"][finite], rtol=1e-5, err_msg=what
+                got.details.costs[finite], ref.details.costs[finite], rtol=1e-5, err_msg=what
             )
     assert compared >= len(names), f"only {compared} of {2 * len(names)} plans found a grasp to compare"

@@ -4,9 +4,9 @@ import dataclasses
 
 import numpy as np
 import pytest
+from helpers.planning import IN_AREA, PAPER_STEPS_ONLY, RG2, box_cloud, cylinder_cloud, request
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from test_planner_common import PAPER_STEPS_ONLY, RG2, box_cloud, cylinder_cloud, request
 
 from graspexp.config import OptimalConfig
 from graspexp.core.geometry import quat_wxyz_to_matrix
@@ -41,40 +41,40 @@ def _upright_cylinder(seed=0, n=512, table_z=0.1):
 
 def _check_result(res, req):
     g, det = res.grasp, res.details
-    assert DETAIL_KEYS <= set(det)
-    k, m = det["costs"].shape
-    assert m == req.planner.m and det["directions"].shape == (k, m, 3)
-    assert det["centers"].shape == (k, 3) and det["radii"].shape == (k,)
-    assert np.isinf(det["costs"][~det["feasible"]]).all()
-    assert np.isfinite(det["costs"][det["feasible"]]).all()
-    kb, pb = det["best"]
+    assert DETAIL_KEYS <= set(res.detail_arrays())
+    k, m = det.costs.shape
+    assert m == req.planner.m and det.directions.shape == (k, m, 3)
+    assert det.centers.shape == (k, 3) and det.radii.shape == (k,)
+    assert np.isinf(det.costs[~det.feasible]).all()
+    assert np.isfinite(det.costs[det.feasible]).all()
+    kb, pb = det.best
     assert (g.cluster, g.path) == (kb, pb)
-    assert det["feasible"][kb, pb]
-    assert g.cost == det["costs"][kb, pb] == det["costs"].min()
+    assert det.feasible[kb, pb]
+    assert g.cost == det.costs[kb, pb] == det.costs.min()
     # Pose per Fig. 9.
     R = g.pose[:3, :3]
     np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-9)
     assert np.linalg.det(R) == pytest.approx(1.0, abs=1e-9)
-    np.testing.assert_allclose(g.approach, det["directions"][kb, pb], atol=1e-12)
+    np.testing.assert_allclose(g.approach, det.directions[kb, pb], atol=1e-12)
     assert abs(R[:, 0] @ R[:, 2]) < 1e-9
     # Origin: c_k moved along Y to the middle of the section between the pads.
     shift = g.extras["centre_shift_m"]
-    assert shift == pytest.approx(det["section_span"][kb, pb].mean(), abs=1e-15)
-    np.testing.assert_allclose(g.position, det["centers"][kb] + shift * R[:, 1], atol=1e-12)
-    lo, hi = det["section_span"][kb, pb] - shift
+    assert shift == pytest.approx(det.section_span[kb, pb].mean(), abs=1e-15)
+    np.testing.assert_allclose(g.position, det.centers[kb] + shift * R[:, 1], atol=1e-12)
+    lo, hi = det.section_span[kb, pb] - shift
     assert -g.width_m / 2 <= lo <= hi <= g.width_m / 2  # both pads clear the section
-    np.testing.assert_array_equal(g.pose, det["pose"])
+    np.testing.assert_array_equal(g.pose, det.pose)
     # The path starts above the support plane.
-    start = det["centers"][kb] - req.planner.sphere_radius_m * det["directions"][kb, pb]
+    start = det.centers[kb] - req.planner.sphere_radius_m * det.directions[kb, pb]
     assert start[2] >= req.table_z + req.planner.table_clearance_m
     # Width inside the stroke, section between the pads too.
     assert req.gripper.min_width_m <= g.width_m <= req.gripper.max_width_m
-    assert g.width_m == det["width"]
+    assert g.width_m == det.width
     assert g.extras["slab_extent_m"] <= req.gripper.max_width_m
     assert g.extras["slab_extent_m"] <= g.width_m  # the open fingers clear the section they close on
-    assert det["section_width"][kb, pb] == g.extras["slab_extent_m"]
+    assert det.section_width[kb, pb] == g.extras["slab_extent_m"]
     assert g.planner == "optimal" and g.extras["K"] == k and g.extras["M"] == m
-    assert g.n_feasible == int(det["feasible"].sum())
+    assert g.n_feasible == int(det.feasible.sum())
 
 
 @pytest.mark.parametrize("mode", ["collab", "bin"])
@@ -83,14 +83,14 @@ def test_plan_contract_on_an_upright_cylinder(mode):
     req = request(pts, mask, table_z=0.1, mode=mode)
     res = plan_optimal(req)
     _check_result(res, req)
-    np.testing.assert_array_equal(res.details["cloud"], pts)
-    np.testing.assert_array_equal(res.details["area_mask"], mask)
-    assert str(res.details["mode"]) == mode
+    np.testing.assert_array_equal(res.details.cloud, pts)
+    np.testing.assert_array_equal(res.details.area_mask, mask)
+    assert str(res.details.mode) == mode
     # The cylinder's area is 80 mm tall and 60 mm wide: its main axis is vertical and the best
     # collab path is close to orthogonal to it (Eq. 1's first factor).
-    assert abs(res.details["main_axis"][2]) > 0.9
+    assert abs(res.details.main_axis[2]) > 0.9
     if mode == "collab":
-        assert abs(res.grasp.approach @ res.details["main_axis"]) < 0.5
+        assert abs(res.grasp.approach @ res.details.main_axis) < 0.5
 
 
 def test_bin_mode_prefers_steeper_paths_near_the_table():
@@ -116,7 +116,7 @@ def test_same_seed_gives_the_same_grasp_bit_for_bit():
         b.grasp.path,
     )
     for key in DETAIL_KEYS:
-        assert np.asarray(a.details[key]).tobytes() == np.asarray(b.details[key]).tobytes(), key
+        assert a.detail_arrays()[key].tobytes() == b.detail_arrays()[key].tobytes(), key
 
 
 def test_k_auto_follows_the_area_length_and_the_gripper():
@@ -135,7 +135,7 @@ def test_k_auto_follows_the_area_length_and_the_gripper():
     capped = OptimalConfig(name="optimal", m=64, k_max=2)
     assert plan_optimal(request(pts, mask, planner=capped)).grasp.extras["K"] == 2
     fixed = OptimalConfig(name="optimal", m=64, k=3)
-    assert plan_optimal(request(pts, mask, planner=fixed)).details["centers"].shape == (3, 3)
+    assert plan_optimal(request(pts, mask, planner=fixed)).details.centers.shape == (3, 3)
 
 
 def test_empty_area_raises():
@@ -175,8 +175,8 @@ def test_paths_found_too_wide_are_skipped_for_the_next_cheapest():
     res = plan_optimal(request(pts, mask, table_z=-1.0, gripper=narrow))
     assert res.grasp.extras["n_too_wide"] > 0
     assert res.grasp.extras["slab_extent_m"] <= 0.045
-    assert (~res.details["feasible"]).sum() == res.grasp.extras["n_too_wide"]  # no table in reach
-    assert res.grasp.cost == res.details["costs"].min()
+    assert (~res.details.feasible).sum() == res.grasp.extras["n_too_wide"]  # no table in reach
+    assert res.grasp.cost == res.details.costs.min()
 
 
 def test_a_band_shorter_than_its_diameter_is_closed_across_not_along_its_height():
@@ -193,7 +193,7 @@ def test_a_band_shorter_than_its_diameter_is_closed_across_not_along_its_height(
     req = request(pts, mask, table_z=0.1, planner=area_axes)
     res = plan_optimal(req)
     _check_result(res, req)
-    assert abs(res.details["main_axis"][2]) < 0.3
+    assert abs(res.details.main_axis[2]) < 0.3
     assert abs(res.grasp.pose[2, 1]) < 0.3  # closing axis Y is (nearly) horizontal
     assert res.grasp.extras["slab_extent_m"] < 0.075
     assert res.grasp.extras["n_too_wide"] > 0 and not res.grasp.extras["widened"]
@@ -206,7 +206,7 @@ def test_object_main_axis_of_a_can_is_its_height():
     pts = cylinder_cloud(rng, 2048, radius_m=0.033, height_m=0.10) + [0.0, 0.0, 0.1]
     mask = (pts[:, 2] > 0.13) & (pts[:, 2] < 0.17)
     res = plan_optimal(request(pts, mask, table_z=0.1, planner=OptimalConfig(name="optimal")))
-    assert abs(res.details["main_axis"][2]) > 0.95
+    assert abs(res.details.main_axis[2]) > 0.95
     assert abs(res.grasp.pose[2, 1]) < 0.3
 
 
@@ -222,7 +222,7 @@ def test_opening_is_widened_when_no_section_fits_the_cluster_radius():
     _check_result(res, req)
     g = res.grasp
     assert g.extras["widened"]
-    assert g.width_m > 2 * res.details["radii"][g.cluster] * 1.2
+    assert g.width_m > 2 * res.details.radii[g.cluster] * 1.2
     assert g.width_m == pytest.approx(min(g.extras["slab_extent_m"] * 1.2, RG2.max_width_m))
 
 
@@ -293,7 +293,7 @@ def test_property_valid_grasp_for_random_clouds_and_poses(
     )
     res = plan_optimal(req)
     _check_result(res, req)
-    checked = dataclasses.replace(req, planner=OptimalConfig(name="optimal", m=64))
+    checked = dataclasses.replace(req, planner=OptimalConfig(name="optimal", m=64, **IN_AREA))
     try:
         res = plan_optimal(checked)
     except NoFeasibleGrasp as e:
@@ -303,4 +303,4 @@ def test_property_valid_grasp_for_random_clouds_and_poses(
     g = res.grasp
     assert cloud_hits(world, g.pose[None], RG2, g.width_m, sweep_m=0.1, margin_m=0.0)[0] == 0
     assert lowest_z(g.pose[None], RG2, g.width_m, 0.1)[0] >= table_z
-    assert res.details["contact_share"][g.cluster, g.path] == 1.0
+    assert res.details.contact_share[g.cluster, g.path] == 1.0

@@ -4,7 +4,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from test_planner_common import RG2
+from helpers.planning import RG2
 
 from graspexp.planning.paths import fibonacci_sphere
 from graspexp.planning.pose import (

@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
-from conftest import compose_cfg
+from helpers.config import compose_cfg
+from helpers.planning import PAPER_STEPS_ONLY, RG2, cylinder_cloud, request
 from omegaconf import OmegaConf
-from test_planner_common import PAPER_STEPS_ONLY, RG2, cylinder_cloud, request
 
 from graspexp.config import OptimalConfig
 from graspexp.planning import plan_optimal
@@ -26,26 +26,26 @@ def _plan(**keys):
 def test_cluster_radius_max_is_the_farthest_member_and_sets_the_opening():
     far, rms = _plan(cluster_radius="max"), _plan(cluster_radius="rms")
     pts, mask = _can_with_band()
-    area, labels = pts[mask], far.details["labels"]
-    for j, c in enumerate(far.details["centers"]):
-        assert far.details["radii"][j] == pytest.approx(np.linalg.norm(area[labels == j] - c, axis=1).max())
-    assert (far.details["radii"] > rms.details["radii"]).all()
+    area, labels = pts[mask], far.details.labels
+    for j, c in enumerate(far.details.centers):
+        assert far.details.radii[j] == pytest.approx(np.linalg.norm(area[labels == j] - c, axis=1).max())
+    assert (far.details.radii > rms.details.radii).all()
     k = far.grasp.cluster
     if not far.grasp.extras["widened"]:
-        expected = min(2 * far.details["radii"][k] * 1.2, RG2.max_width_m)
+        expected = min(2 * far.details.radii[k] * 1.2, RG2.max_width_m)
         assert far.grasp.width_m == pytest.approx(expected)
 
 
 def test_grasp_point_centre_keeps_c_k_and_section_middle_moves_along_y_only():
     centre, middle = _plan(grasp_point="centre"), _plan(grasp_point="section_middle")
     assert (centre.grasp.cluster, centre.grasp.path) == (middle.grasp.cluster, middle.grasp.path)
-    c_k = centre.details["centers"][centre.grasp.cluster]
+    c_k = centre.details.centers[centre.grasp.cluster]
     np.testing.assert_array_equal(centre.grasp.pose[:3, 3], c_k)
     assert centre.grasp.extras["centre_shift_m"] == 0.0
     offset = middle.grasp.pose[:3, 3] - c_k
     shift = middle.grasp.extras["centre_shift_m"]
     np.testing.assert_allclose(offset, shift * middle.grasp.pose[:3, 1], atol=1e-12)
-    lo, hi = middle.details["section_span"][middle.grasp.cluster, middle.grasp.path]
+    lo, hi = middle.details.section_span[middle.grasp.cluster, middle.grasp.path]
     assert shift == pytest.approx((lo + hi) / 2)
 
 
@@ -53,7 +53,7 @@ def test_without_the_section_fit_the_cheapest_path_wins_even_if_the_object_is_wi
     # Opening 2 r_k with r_k the RMS radius and no margin: far too narrow for the can's 66 mm section.
     keys = {"cluster_radius": "rms", "width_margin": 0.0, "k": 3, **PAPER_STEPS_ONLY}
     fit, printed = _plan(section_fit=True, **keys), _plan(section_fit=False, **keys)
-    costs = printed.details["costs"]
+    costs = printed.details.costs
     assert printed.grasp.cost == costs.min()
     assert printed.grasp.extras["n_too_wide"] == 0 and not printed.grasp.extras["widened"]
     assert printed.grasp.n_feasible == int(np.isfinite(costs).sum())
@@ -71,8 +71,8 @@ def test_pose_axis_sets_the_grasp_x_axis_and_main_axis_the_cost_angle():
         a = main_axis(cloud)
         expected = a - (a @ z) * z
         np.testing.assert_allclose(x, expected / np.linalg.norm(expected), atol=1e-9)
-        np.testing.assert_array_equal(res.details["pose_axis"], a)
-        np.testing.assert_array_equal(res.details["main_axis"], main_axis(pts))  # alpha unchanged
+        np.testing.assert_array_equal(res.details.pose_axis, a)
+        np.testing.assert_array_equal(res.details.main_axis, main_axis(pts))  # alpha unchanged
 
 
 def test_presets_differ_only_in_the_documented_reading_keys():
@@ -116,17 +116,17 @@ def test_area_if_elongated_takes_the_area_axis_of_a_long_area_and_the_object_axi
         name="optimal", pose_axis="area_if_elongated", min_contacts_in_area=0.0, swept_check=False
     )
     res = plan_optimal(request(pts, mask, table_z=0.1, planner=pl))
-    np.testing.assert_array_equal(res.details["pose_axis"], main_axis(pts[mask]))
+    np.testing.assert_array_equal(res.details.pose_axis, main_axis(pts[mask]))
     assert abs(main_axis(pts) @ main_axis(pts[mask])) < 0.95
     # A band around a can (elongation ~1: any direction across it is a first component): the object's.
     can, band = _can_with_band()
     assert elongation(can[band]) < 1.5
     res = plan_optimal(request(can, band, table_z=0.1, planner=pl))
-    np.testing.assert_array_equal(res.details["pose_axis"], main_axis(can))
+    np.testing.assert_array_equal(res.details.pose_axis, main_axis(can))
     # The threshold decides: above the area's elongation, the object's axis is used there too.
     high = OptimalConfig(**{**pl.__dict__, "pose_axis_min_elongation": elongation(pts[mask]) + 1})
     res = plan_optimal(request(pts, mask, table_z=0.1, planner=high))
-    np.testing.assert_array_equal(res.details["pose_axis"], main_axis(pts))
+    np.testing.assert_array_equal(res.details.pose_axis, main_axis(pts))
 
 
 def test_elongation_is_the_ratio_of_the_principal_standard_deviations():
@@ -142,7 +142,7 @@ def test_literal_preset_plans_the_printed_argmin_at_c_k():
     pl = OmegaConf.to_object(cfg.planner)
     res = plan_optimal(request(pts, mask, table_z=0.1, planner=pl))
     assert res.grasp.planner == "optimal_literal"
-    assert res.grasp.cost == res.details["costs"].min()
-    np.testing.assert_array_equal(res.grasp.pose[:3, 3], res.details["centers"][res.grasp.cluster])
-    expected = min(2 * res.details["radii"][res.grasp.cluster], RG2.max_width_m)
+    assert res.grasp.cost == res.details.costs.min()
+    np.testing.assert_array_equal(res.grasp.pose[:3, 3], res.details.centers[res.grasp.cluster])
+    expected = min(2 * res.details.radii[res.grasp.cluster], RG2.max_width_m)
     assert res.grasp.width_m == pytest.approx(expected)

@@ -1,12 +1,11 @@
 """The planner on every real mesh of the shared data root (skipped without it), plus its CLIs."""
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
-from test_planner_common import PAPER_STEPS_ONLY, RG2, UPRIGHT_SUPPORT_Z, upright_request
+from helpers.cli import graspexp
+from helpers.planning import IN_AREA, PAPER_STEPS_ONLY, RG2, UPRIGHT_SUPPORT_Z, upright_request
 
 from graspexp.config import DatasetConfig, OptimalConfig
 from graspexp.config.compose import compose_config
@@ -28,7 +27,7 @@ def _present(root, dataset):
 @pytest.mark.parametrize("dataset", ["ycb", "linemod"])
 def test_plan_every_real_object_in_both_modes(data_root, dataset):
     """The paper's steps alone plan every object upright in both modes; with the swept check and the
-    area rule (the defaults) a grasp, where there is one, keeps the gripper clear and its pads in the
+    area rule (optimal_in_area's keys) a grasp, where there is one, keeps the gripper clear and its pads in the
     area, and the rest fail with the check that rejected them named."""
     cfg, names = _present(data_root, dataset)
     if not names:
@@ -42,7 +41,7 @@ def test_plan_every_real_object_in_both_modes(data_root, dataset):
         assert pts[:, 2].min() >= support_z - 1e-9
         for mode in ("collab", "bin"):
             for checked in (False, True):
-                keys = {} if checked else PAPER_STEPS_ONLY
+                keys = IN_AREA if checked else PAPER_STEPS_ONLY
                 req = upright_request(model, pose, mode, OptimalConfig(name="optimal", **keys))
                 try:
                     res = plan(req)
@@ -61,14 +60,14 @@ def test_plan_every_real_object_in_both_modes(data_root, dataset):
                 start = g.position - 0.1 * g.approach
                 assert start[2] >= support_z, (name, mode)
                 assert RG2.min_width_m <= g.width_m <= RG2.max_width_m
-                assert det["area_mask"].sum() > 0
+                assert det.area_mask.sum() > 0
                 # The grasp point is the centre of a cluster of area points, so it is near the area.
                 area = pts[model.area_mask]
                 assert np.min(np.linalg.norm(area - g.position, axis=1)) < 0.06, (name, mode)
                 if checked:
                     assert cloud_hits(pts, g.pose[None], RG2, g.width_m, sweep_m=0.1, margin_m=0.0)[0] == 0
                     assert lowest_z(g.pose[None], RG2, g.width_m, 0.1)[0] >= support_z, (name, mode)
-                    assert det["contact_share"][g.cluster, g.path] == 1.0, (name, mode)
+                    assert det.contact_share[g.cluster, g.path] == 1.0, (name, mode)
     assert planned > 0
 
 
@@ -99,12 +98,7 @@ def test_plan_cli_prints_one_json_object_and_dumps(tmp_path, capsys, monkeypatch
 
 @pytest.mark.slow
 def test_plan_cli_unknown_object_is_one_line_and_non_zero():
-    proc = subprocess.run(
-        [sys.executable, "-m", "graspexp", "plan", "dataset=primitives", "objects=[teapot]"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    proc = graspexp("plan", "dataset=primitives", "objects=[teapot]", timeout=120)
     assert proc.returncode == 2
     assert proc.stdout == ""
     lines = proc.stderr.strip().splitlines()

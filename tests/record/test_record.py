@@ -10,7 +10,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import strictly_valid
+from helpers.cli import graspexp
+from helpers.logs import strictly_valid
 from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory
 
@@ -179,7 +180,7 @@ def test_round_trip_file(trial_file):
         "/contacts": "foxglove.PointCloud",
         "/grasp": "graspexp.PlannedGrasp@1",
         "/phase": "graspexp.Phase@1",
-        "/result": "graspexp.TrialResult@3",
+        "/result": "graspexp.TrialResult@4",
     }
     n = int(RATE_HZ * DURATION_S)
     assert sorted(log.transforms) == ["finger_left", "finger_right", "gripper", "object"]
@@ -310,7 +311,7 @@ def test_scene_entities_follow_foxglove_layout(trial_file):
 
 def test_result_schema_pinned():
     """Changing TrialResult's fields must come with a new graspexp.TrialResult@N version."""
-    assert S.TRIAL_RESULT == "graspexp.TrialResult@3"
+    assert S.TRIAL_RESULT == "graspexp.TrialResult@4"
     assert list(S.SCHEMAS[S.TRIAL_RESULT]["properties"]) == [
         "dataset",
         "object",
@@ -334,6 +335,11 @@ def test_result_schema_pinned():
         "sim_time_s",
         "steps",
         "at_rest",
+        "pose_trans_err_mm",
+        "pose_rot_err_deg",
+        "pose_adds_mm",
+        "registration_fitness",
+        "registration_cpu_s",
     ]
 
 
@@ -471,14 +477,7 @@ def test_iter_trial_logs(tmp_path):
 
 
 def _replay(*args: str) -> subprocess.CompletedProcess:
-    root = Path(__file__).resolve().parents[2]
-    return subprocess.run(
-        [sys.executable, "-m", "graspexp", "replay", *args],
-        capture_output=True,
-        text=True,
-        cwd=root,
-        timeout=120,
-    )
+    return graspexp("replay", *args, timeout=120)
 
 
 def test_replay_prints_timeline(trial_file):

@@ -1,12 +1,11 @@
 """The failure gallery and the readings table, from real trial logs of two small runs (one per reading)."""
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
+from helpers.cli import ok, run_job
 
 from graspexp.record import read_trial
 from graspexp.report import collect
@@ -15,23 +14,13 @@ from graspexp.report.readings import MixedConfigError, readings_report
 from graspexp.run.suites import ALL, READINGS, reading_sweep
 from graspexp.tools.readings import main as readings_main
 
-pytestmark = [pytest.mark.sim, pytest.mark.slow]
+pytestmark = pytest.mark.slow
 REPO = Path(__file__).resolve().parents[2]
 OBJECTS = "objects=[box,block,mug]"
 
 
 def _run(run_dir: Path, *overrides: str) -> None:
-    cmd = [
-        sys.executable,
-        "-m",
-        "graspexp",
-        "progress=false",
-        f"hydra.run.dir={run_dir}",
-        "trials=2",
-        OBJECTS,
-    ]
-    proc = subprocess.run([*cmd, *overrides], cwd=REPO, capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stderr[-2000:]
+    ok(run_job(run_dir, "trials=2", OBJECTS, *overrides))
 
 
 @pytest.fixture(scope="module")

@@ -5,7 +5,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from conftest import compose_cfg, foreign_log
+from helpers.config import compose_cfg
+from helpers.logs import foreign_log
 
 from graspexp.core.outcome import FailureReason, TrialResult
 from graspexp.datasets import dataset_objects

@@ -3,14 +3,14 @@ re-dropped: its log keeps one clock across the drops, and re-simulation reproduc
 
 import numpy as np
 import pytest
-from conftest import shared_data_root
+from helpers.config import shared_data_root
 
 from graspexp.config.compose import compose_config
 from graspexp.record import read_trial
 from graspexp.run.resim import resimulate
 from graspexp.run.runner import run_in_dir
 
-pytestmark = [pytest.mark.sim, pytest.mark.slow]
+pytestmark = pytest.mark.slow
 
 
 def test_a_redropped_trial_logs_one_clock_and_resimulates(tmp_path):

@@ -1,27 +1,25 @@
 """Resume never mixes trials made on two meshes: each log records its mesh file and the SHA-256 of the
 geometry used; a run whose data root now gives another geometry of an object is refused in one line."""
 
-import os
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
-from conftest import shared_data_root
+from helpers.cli import run_job
+from helpers.config import shared_data_root
 
 from graspexp.record import read_trial
 
-pytestmark = [pytest.mark.sim, pytest.mark.slow]
+pytestmark = pytest.mark.slow
 REPO = Path(__file__).resolve().parents[2]
 MUG = "025_mug"
 
 
 def _run(run_dir: Path, data: Path, trials: int) -> subprocess.CompletedProcess:
-    cmd = [sys.executable, "-m", "graspexp", "dataset=ycb", f"objects=[{MUG}]", f"trials={trials}"]
-    cmd += ["progress=false", f"hydra.run.dir={run_dir}"]
-    env = {**os.environ, "GRASPEXP_DATA": str(data)}
-    return subprocess.run(cmd, cwd=REPO, env=env, capture_output=True, text=True, timeout=300)
+    return run_job(
+        run_dir, "dataset=ycb", f"objects=[{MUG}]", f"trials={trials}", env={"GRASPEXP_DATA": str(data)}
+    )
 
 
 def test_a_rescaled_mesh_under_another_data_root_is_refused(tmp_path):

@@ -4,7 +4,7 @@ prepare step, and the 1 mm target on real meshes."""
 import numpy as np
 import pytest
 import trimesh
-from conftest import compose_cfg
+from helpers.config import compose_cfg
 from omegaconf import OmegaConf
 
 from graspexp.config import SimConfig
@@ -143,7 +143,6 @@ def test_default_shape_is_within_1_mm_of_real_meshes(data_root, name):
     assert acc.inside_p90_mm <= 1.0
 
 
-@pytest.mark.sim
 def test_mesh_rests_on_the_support_and_sdf_spacing_changes_no_contact(tmp_path):
     cfg = compose_cfg("dataset=primitives", "mode=bin")  # a wide table: the mug may roll
     mode = OmegaConf.to_object(cfg.mode)

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from conftest import compose_cfg
+from helpers.config import compose_cfg
 
 from graspexp.core.bodies import SUPPORT_NAME
 from graspexp.core.geometry import make_pose, quat_wxyz_to_matrix
@@ -13,8 +13,6 @@ from graspexp.planning.request import PlanResult
 from graspexp.run.objects import load_object, trial_context
 from graspexp.sim.contacts import GRIPPER_LINKS
 from graspexp.sim.trial import NullRecorder, plain_config, run_trial
-
-pytestmark = pytest.mark.sim
 
 
 class ContactCapture(NullRecorder):

@@ -5,16 +5,15 @@ grasps and holds in both modes."""
 import numpy as np
 import pytest
 import sapien
-from conftest import compose_cfg, write_urdf_gripper
+from helpers.config import compose_cfg
+from helpers.objects import write_urdf_gripper
+from helpers.sim import THIN_M, steady_finger_forces
 from omegaconf import OmegaConf
-from test_grip_force import THIN_M, steady_finger_forces
 
 from graspexp.run.job_config import make_ready
 from graspexp.run.objects import load_object, trial_context
 from graspexp.sim.gripper import build_gripper
 from graspexp.sim.trial import plain_config, run_trial
-
-pytestmark = pytest.mark.sim
 
 
 @pytest.fixture

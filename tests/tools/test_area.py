@@ -10,13 +10,14 @@ import numpy as np
 import pytest
 import trimesh
 import yaml
-from conftest import compose_cfg, shared_data_root
+from helpers.config import compose_cfg, shared_data_root
 
 from graspexp.datasets import ObjectModel, job_object
 from graspexp.datasets.folder import read_sidecar
 from graspexp.datasets.primitives import PRIMITIVES
 from graspexp.datasets.regions import area_mask, parse_entry
-from graspexp.tools.area import MAX_FACES, main, render_mesh
+from graspexp.report.area_view import MAX_FACES, render_mesh
+from graspexp.tools.area import main
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 

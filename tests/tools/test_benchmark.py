@@ -7,9 +7,11 @@ import pandas as pd
 import pytest
 
 from graspexp.config import ConfigError
+from graspexp.report.benchmark import ranking
 from graspexp.report.paper import PAPER_TABLES, SETTINGS
+from graspexp.run.benchmark import compared, jobs, sweep_command
 from graspexp.run.suites import NOISE_LEVELS
-from graspexp.tools.benchmark import compared, jobs, parse_args, ranking, sweep_command
+from graspexp.tools.benchmark import parse_args
 
 
 def test_standard_suite_is_four_settings_on_both_tables_at_every_noise_level_for_every_planner():

@@ -16,8 +16,8 @@ import pytest
 import graspexp
 from graspexp.config.job import JobConfig
 from graspexp.config.plugins import LoadedPlanner, load_planners
+from graspexp.config.reference import render
 from graspexp.config.registry import SCHEMAS, group_options
-from graspexp.tools.config_reference import render
 
 ROOT = Path(graspexp.__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
@@ -96,7 +96,6 @@ def test_every_tutorial_has_a_tested_block():
 
 
 @pytest.mark.slow
-@pytest.mark.sim
 @pytest.mark.parametrize("page", TUTORIALS, ids=lambda p: str(p.relative_to(DOCS)))
 def test_the_tested_commands_of_a_page_run_as_written(page, tmp_path):
     """Each page's tested blocks run in order in one fresh folder that holds a link to the checkout's
@@ -202,7 +201,7 @@ def test_every_readme_command_runs_as_written_or_dry(tmp_path):
     jobs compose and validate (``--cfg job``), from a folder that holds the README's example inputs
     (``my_parts/bracket.stl`` in mm, ``my_gripper/gripper.urdf``); the nox sessions exist."""
     import trimesh
-    from conftest import write_urdf_gripper
+    from helpers.objects import write_urdf_gripper
 
     (tmp_path / "my_parts").mkdir()
     trimesh.creation.box((50, 30, 80)).export(tmp_path / "my_parts" / "bracket.stl")

@@ -21,8 +21,8 @@ import pytest
 import trimesh
 
 from graspexp.config import DatasetConfig
-from graspexp.datasets import DatasetError, load_object
-from graspexp.tools import download
+from graspexp.datasets import DatasetError, download, load_object
+from graspexp.tools import download as download_tool
 
 YCB_ID = "061_foam_brick"
 
@@ -119,7 +119,7 @@ def test_ycb_download_records_hash_and_loads(server, tmp_path, capsys):
     archive = ycb_archive(folder)
     root = tmp_path / "data"
     argv = ["dataset=ycb", f"dataset.root={root}", f"objects=[{YCB_ID}]", "--base-url", url, "progress=false"]
-    assert download.main(argv) == 0
+    assert download_tool.main(argv) == 0
     assert (root / "ycb" / YCB_ID / "google_16k" / "textured.obj").is_file()
     registry = json.loads((root / download.HASH_REGISTRY).read_text())
     entry = registry[f"ycb/{archive.name}"]
@@ -133,7 +133,7 @@ def test_ycb_download_records_hash_and_loads(server, tmp_path, capsys):
 
     # A re-run finds the verified archive and downloads nothing.
     assert len(log) == 1
-    assert download.main(argv) == 0
+    assert download_tool.main(argv) == 0
     assert len(log) == 1
 
 
@@ -148,7 +148,7 @@ def test_ycb_tampered_archive_fails_clearly(server, tmp_path, capsys):
     ycb_archive(folder, size=0.07)  # the server now serves different bytes under the same name
     (root / download.ARCHIVE_DIR / f"{YCB_ID}_google_16k.tgz").unlink()  # e.g. a fresh machine, same root
     argv = ["dataset=ycb", f"dataset.root={root}", f"objects=[{YCB_ID}]", "--base-url", url, "progress=false"]
-    assert download.main(argv) == 2
+    assert download_tool.main(argv) == 2
     err = capsys.readouterr().err
     assert err.startswith(
         "graspexp download: error: checksum mismatch for " + url + f"{YCB_ID}_google_16k.tgz"
@@ -175,7 +175,8 @@ def test_linemod_wrong_hash_fails_clearly(server, tmp_path, capsys):
     linemod_archive(folder)  # not the published archive, so the published SHA-256 cannot match
     root = tmp_path / "data"
     assert (
-        download.main(["dataset=linemod", f"dataset.root={root}", "--base-url", url, "progress=false"]) == 2
+        download_tool.main(["dataset=linemod", f"dataset.root={root}", "--base-url", url, "progress=false"])
+        == 2
     )
     err = capsys.readouterr().err
     assert "checksum mismatch for " + url + download.LINEMOD_ARCHIVE in err
@@ -189,10 +190,10 @@ def test_base_url_from_environment(server, tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("GRASPEXP_LINEMOD_URL", url.rstrip("/"))
     root = tmp_path / "data"
     argv = ["dataset=linemod", f"dataset.root={root}", f"--sha256={digest}", "progress=false"]
-    assert download.main(argv) == 0  # the default list: the 12 models this archive lacks are a warning
+    assert download_tool.main(argv) == 0  # the default list: the 12 models this archive lacks are a warning
     assert "lacks the models of: benchvise" in capsys.readouterr().err
     assert log == ["/" + download.LINEMOD_ARCHIVE]
-    assert download.main([*argv, "objects=[ape,cam]"]) == 2  # explicitly requested: an error
+    assert download_tool.main([*argv, "objects=[ape,cam]"]) == 2  # explicitly requested: an error
     assert "lacks the models of: cam" in capsys.readouterr().err
     assert download.base_url("ycb") == download.YCB_URL
 
@@ -213,10 +214,10 @@ def test_unsafe_archive_member_is_refused(server, tmp_path):
 
 def test_cli_arguments(monkeypatch, tmp_path):
     monkeypatch.setenv("GRASPEXP_DATA", str(tmp_path))
-    args = download.parse_args(["dataset=ycb", "objects=[025_mug, 011_banana]"])
+    args = download_tool.parse_args(["dataset=ycb", "objects=[025_mug, 011_banana]"])
     assert args.root == tmp_path and args.objects == ["025_mug", "011_banana"]
-    assert len(download.parse_args(["dataset=ycb", "--all"]).objects) == 78
-    assert download.parse_args(["dataset=linemod", "dataset.root=/x"]).root == Path("/x")
+    assert len(download_tool.parse_args(["dataset=ycb", "--all"]).objects) == 78
+    assert download_tool.parse_args(["dataset=linemod", "dataset.root=/x"]).root == Path("/x")
     bad_args = (
         ["dataset.root=/x"],
         ["dataset=primitives"],
@@ -225,7 +226,7 @@ def test_cli_arguments(monkeypatch, tmp_path):
     )
     for bad in bad_args:
         with pytest.raises(SystemExit):
-            download.parse_args(bad)
+            download_tool.parse_args(bad)
     with pytest.raises(DatasetError, match="unknown object 'teapot'"):
         download.download_ycb(tmp_path, ["teapot"], url="http://127.0.0.1:9/")
 
@@ -316,7 +317,7 @@ def test_an_archive_never_unpacks_over_another_object(server, tmp_path, capsys):
     )
     root = tmp_path / "data"
     argv = ["dataset=ycb", f"dataset.root={root}", f"objects=[{YCB_ID}]", "--base-url", url, "progress=false"]
-    assert download.main(argv) == 2
+    assert download_tool.main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert "holds 025_mug/google_16k/textured.obj, outside 061_foam_brick/" in err and "\n" not in err
     assert not (root / "ycb" / "025_mug").exists()
@@ -332,5 +333,5 @@ def test_a_first_download_must_come_over_https(tmp_path, capsys, url):
         url,
         "progress=false",
     ]
-    assert download.main(argv) == 2
+    assert download_tool.main(argv) == 2
     assert "is not https" in capsys.readouterr().err

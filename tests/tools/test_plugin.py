@@ -37,7 +37,6 @@ def _run(args: list[str], env: dict[str, str], cwd: Path) -> subprocess.Complete
 
 
 @pytest.mark.slow
-@pytest.mark.sim
 def test_example_plugin_runs_through_the_benchmark_beside_a_builtin_planner(tmp_path):
     project = tomllib.loads((EXAMPLE / "pyproject.toml").read_text())["project"]
     env = _register(

@@ -17,7 +17,6 @@ def test_the_sweep_is_the_paper_suite_with_the_papers_planner_logged_and_overrid
 
 
 @pytest.mark.slow
-@pytest.mark.sim
 def test_a_tiny_subset_prints_wall_cpu_and_rate_for_one_and_two_workers(capsys):
     main(["dataset=ycb", "objects=[011_banana]", "mode=collab", "rot=z", "trials=1"])
     out = capsys.readouterr().out

@@ -6,14 +6,13 @@ success of each job's results.csv, its resume, a job that cannot run (a FAIL tri
 and the held-out scoring with its report.
 """
 
-import os
 import subprocess
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
 import yaml
+from helpers.cli import graspexp
 
 from graspexp.config.compose import expand_sweeps
 from graspexp.config.job import OBJECTIVES
@@ -34,9 +33,7 @@ STUDY = [
 
 
 def _graspexp(*args: str, ok: bool = True) -> subprocess.CompletedProcess:
-    env = {**os.environ, "OMP_NUM_THREADS": "1"}
-    cmd = [sys.executable, "-m", "graspexp", *args]
-    proc = subprocess.run(cmd, cwd=REPO, env=env, capture_output=True, text=True, timeout=180)
+    proc = graspexp(*args, timeout=180)
     if ok:
         assert proc.returncode == 0, proc.stderr[-3000:]
     return proc
@@ -60,7 +57,6 @@ def study_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 @pytest.mark.slow
-@pytest.mark.sim
 def test_study_objective_is_each_jobs_mean_success(study_dir: Path) -> None:
     study = read_sweep_study(study_dir).study
     trials = study.get_trials()
@@ -78,7 +74,6 @@ def test_study_objective_is_each_jobs_mean_success(study_dir: Path) -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.sim
 def test_study_resumes_to_n_trials_in_all(study_dir: Path) -> None:
     before = {t.params["cost.angle_weight"] for t in read_sweep_study(study_dir).study.get_trials()}
     _graspexp("-m", *STUDY, "hydra.sweeper.n_trials=4", f"hydra.sweep.dir={study_dir}")
@@ -93,7 +88,6 @@ def test_study_resumes_to_n_trials_in_all(study_dir: Path) -> None:
 
 
 @pytest.mark.slow
-@pytest.mark.sim
 def test_tune_scores_best_and_paper_on_the_test_split(study_dir: Path, tmp_path: Path) -> None:
     preset = tmp_path / "tuned.yaml"
     _graspexp("tune", str(study_dir), "--trials", "1", "--out", str(tmp_path), "--preset", str(preset))

@@ -106,7 +106,11 @@ class OptimalConfig(PaperPathsConfig, AreaRuleConfig):
     the target object can be avoided during the grasping process"; III-D drops "paths that will pass
     through the desktop". The paper tests only the path's start point against the desktop and relies on
     the cost for the rest, so False = as printed."""
-    min_contacts_in_area: float = added(1.0, before=0.0)
+    pose_axis: str = added("area_if_elongated", before="object")
+    """As :class:`PaperPathsConfig` (whose default, ``object``, ``optimal_plus`` keeps). ``area_if_elongated``:
+    Fig. 9 / III-D's "main axis of the grasping area" where the area has one (the preset ``optimal``);
+    ``optimal_literal`` takes ``area`` as printed, ``optimal_in_area`` ``object``."""
+    min_contacts_in_area: float = 0.0
     """Share of each pad's contact points (the object points the pads meet first, within
     ``contact_band_m``) that must be grasping-area points for a path to be kept, tested with the section
     (module doc, step 7). Not in the paper: it aims its paths at the area's cluster centres, does not test

@@ -5,7 +5,7 @@ beside what the planner measured of it.
         [rot=z,xyz] [dataset=ycb,linemod] [objects=[a,b]] [key=value ...]
 
 For each dataset, setting, object and trial the planner runs once; each of its S shortlisted paths
-(``details["shortlist_*"]``, graspexp/planning/optimal_plus.py) is then executed in a fresh trial on the
+(``details.shortlist``, graspexp/planning/optimal_plus.py) is then executed in a fresh trial on the
 same drop by a planner that returns that grasp. One CSV row per simulated grasp: held or not, the failure
 reason, the edge excess (how far the object reaches past a pad's contact plane by the finger edges, the
 measure ``choose_by=edge_clearance`` minimises), the pad depth, whether it passed the noise check, and
@@ -49,11 +49,9 @@ def _forced(j: int, seen: dict):
 
     def planner(req):
         res = seen.get("plan") or seen.setdefault("plan", plan(req))
-        d = res.details
-        grasp = dataclasses.replace(
-            res.grasp, pose=d["shortlist_poses"][j], width_m=float(d["shortlist_widths"][j])
-        )
-        return PlanResult(grasp=grasp, details=d)
+        short = res.details.shortlist
+        grasp = dataclasses.replace(res.grasp, pose=short.poses[j], width_m=float(short.widths[j]))
+        return PlanResult(grasp=grasp, details=res.details)
 
     return planner
 
@@ -73,8 +71,8 @@ def _job(args: tuple[list[str], str, int]) -> list[dict]:
             res = run_trial(trial_context(plain, loaded, i, plan=_forced(j, seen)))
             if "plan" not in seen:  # no grasp planned for this drop: nothing to compare
                 break
-            d = seen["plan"].details
-            n = len(d["shortlist_costs"])
+            short = seen["plan"].details.shortlist
+            n = len(short.costs)
             rows.append(
                 {
                     "object": name,
@@ -82,15 +80,13 @@ def _job(args: tuple[list[str], str, int]) -> list[dict]:
                     "candidate": j,
                     "held": res.success,
                     "reason": res.reason or "",
-                    "edge_excess_mm": 1000 * float(d["shortlist_edge_excess_m"][j]),
-                    "pad_depth_mm": 1000 * float(d["shortlist_pad_depth_m"][j]),
-                    "robust": bool(d["shortlist_robust"][j]),
-                    "cost": float(d["shortlist_costs"][j]),
+                    "edge_excess_mm": 1000 * float(short.edge_excess_m[j]),
+                    "pad_depth_mm": 1000 * float(short.pad_depth_m[j]),
+                    "robust": bool(short.robust[j]),
+                    "cost": float(short.costs[j]),
                     **{
                         f"pick_{rule}": j
-                        == pick_shortlisted(
-                            rule, d["shortlist_costs"], d["shortlist_robust"], d["shortlist_edge_excess_m"]
-                        )
+                        == pick_shortlisted(rule, short.costs, short.robust, short.edge_excess_m)
                         for rule in RULES
                     },
                 }

@@ -1,0 +1,96 @@
+"""What the planner is told at planning time (``perception.*``): the simulator hands the perception stage
+the scene as it is (the object's mesh at its true pose, the support and the floor) and gets back the pose
+the planner sees and, when a camera is rendered, what the camera saw.
+
+``perception.source=truth``: the true pose plus ``perception.noise`` (the paper's experiments; no
+camera unless the planner reads it). ``depth``: the camera renders the scene and the pose is registered
+from its cloud, from a prior (the noisy true pose) or globally (``perception.registration.prior=none``).
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from graspexp.config import JobConfig
+from graspexp.config.plugins import get_plugin
+from graspexp.core.seeding import rng_for
+from graspexp.datasets.model import ObjectModel
+from graspexp.perception import Observation
+from graspexp.perception.camera import BoxBody, MeshBody
+from graspexp.planning.stability import pose_error
+from graspexp.sim.scene import FLOOR_HALF_SIZE_M
+
+TARGET_ID = 1
+"""The object id of the (single) object of a collab or bin trial in the camera's id images."""
+
+
+@dataclass(frozen=True)
+class Perceived:
+    """The planner's view of one trial.
+
+    pose : (4, 4) world pose of the object the planner is given. prior : (4, 4) the noisy true pose (the
+    registration's start with ``perception.source=depth``). observation : what the camera saw, or None.
+    registration : the :class:`graspexp.perception.registration.Registration`, or None. errors : pose
+    errors of ``pose`` against the truth (``trans_mm``, ``rot_deg``, ``adds_mm``) when a pose was registered.
+    """
+
+    pose: np.ndarray
+    prior: np.ndarray
+    observation: Observation | None = None
+    registration: object | None = None
+    errors: dict[str, float] = field(default_factory=dict)
+
+
+def perceived_pose(
+    true_pose: np.ndarray, trans_mm: float, rot_deg: float, rng: np.random.Generator
+) -> np.ndarray:
+    """The pose the planner sees: Gaussian translation (std ``trans_mm``) and a rotation about a random axis
+    by a Gaussian angle (std ``rot_deg``) about the object's origin. Zero noise returns the pose unchanged."""
+    if trans_mm == 0 and rot_deg == 0:
+        return true_pose.copy()
+    dR, trans = pose_error(rng, trans_mm, rot_deg)
+    out = true_pose.copy()
+    out[:3, :3] = dR @ true_pose[:3, :3]
+    out[:3, 3] += trans
+    return out
+
+
+def wants_camera(cfg: JobConfig) -> bool:
+    """Whether the trial renders the camera: ``perception.source=depth``, or a planner that reads it."""
+    return cfg.perception.source == "depth" or get_plugin(cfg.planner.name).plugin.needs_observation
+
+
+def scene_bodies(
+    model: ObjectModel, true_pose: np.ndarray, table_z: float, support_half_m: tuple[float, float] | None
+) -> tuple[list[MeshBody], list[BoxBody]]:
+    """The camera's scene: the object's mesh at its true pose (id :data:`TARGET_ID`), the support box
+    (top at ``table_z``, half sizes ``support_half_m``; None once removed) and the floor (top z = 0)."""
+    fx, fy, fz = FLOOR_HALF_SIZE_M
+    boxes = [BoxBody(np.array([-fx, -fy, -2 * fz]), np.array([fx, fy, 0.0]))]
+    if support_half_m is not None:
+        hx, hy = support_half_m
+        boxes.append(BoxBody(np.array([-hx, -hy, 0.0]), np.array([hx, hy, table_z])))
+    return [MeshBody(model.mesh, true_pose, TARGET_ID)], boxes
+
+
+def perceive(
+    cfg: JobConfig, model: ObjectModel, true_pose: np.ndarray, table_z: float, trial_seed: int
+) -> Perceived:
+    """The planner's view at planning time (module doc); every draw seeded from ``trial_seed``."""
+    noise = cfg.perception.noise
+    prior = perceived_pose(true_pose, noise.trans_mm, noise.rot_deg, rng_for(trial_seed, "noise"))
+    if not wants_camera(cfg):
+        return Perceived(pose=prior, prior=prior)
+    from graspexp.perception.observe import estimate_pose, observe
+    from graspexp.perception.registration import pose_errors
+
+    meshes, boxes = scene_bodies(model, true_pose, table_z, tuple(cfg.mode.support_half_size_m))
+    obs = observe(cfg.perception, meshes, boxes, table_z, TARGET_ID, rng=rng_for(trial_seed, "camera"))
+    if cfg.perception.source != "depth":
+        return Perceived(pose=prior, prior=prior, observation=obs)
+    start = None if cfg.perception.registration.prior == "none" else prior
+    reg = estimate_pose(
+        cfg.perception, obs, model.points, model.normals, start, rng=rng_for(trial_seed, "registration")
+    )
+    errors = pose_errors(reg.pose, true_pose, model.points)
+    return Perceived(pose=reg.pose, prior=prior, observation=obs, registration=reg, errors=errors)
