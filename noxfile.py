@@ -1,5 +1,5 @@
 """Sessions CI and developers call: ``nox -s tests``, ``nox -s lint``, ``nox -s docs``, ``nox -s wheel``,
-``nox -s bench``, ``nox -s learned``, ``nox -s reproduce``, ``nox -s slurm``."""
+``nox -s bench``, ``nox -s learned``, ``nox -s reproduce``, ``nox -s results``, ``nox -s slurm``."""
 
 import os
 import shutil
@@ -199,6 +199,17 @@ def readings(session: nox.Session) -> None:
     start = time.perf_counter()
     session.run("python", "-m", "graspexp", "readings", *session.posargs, env=ENV, external=True)
     session.log(f"readings: {time.perf_counter() - start:.0f} s wall")
+
+
+@nox.session(venv_backend="none")
+def results(session: nox.Session) -> None:
+    """Every results page (``docs/results/``) and the README's results table from runs of this code
+    (``python -m graspexp results``): resumable (run it again after an interruption), progress on stderr.
+    ``nox -s results -- --check`` checks the pages' fingerprints instead; further posargs go to the tool
+    (``--pages index,readme``, ``hydra/launcher=submitit_slurm hydra.launcher.partition=P``)."""
+    start = time.perf_counter()
+    session.run("python", "-m", "graspexp", "results", *session.posargs, env=ENV, external=True)
+    session.log(f"results: {time.perf_counter() - start:.0f} s wall")
 
 
 @nox.session(venv_backend="none")

@@ -3,7 +3,7 @@ the pads.
 
 Each kernel is a plain serial loop (no threads: on a shared 2-core machine ``prange`` was 20x slower) that
 numba compiles on first use and caches on disk, so a process pays the compilation once per machine and
-afterwards only numba's import and the cache load (README, "Development"). The cache lives in
+afterwards only numba's import and the cache load (docs/guide/development.md). The cache lives in
 ``$NUMBA_CACHE_DIR`` when set, else in a per-user folder (:func:`numba_cache_dir`, mode 0700), never in the
 shared ``$GRASPEXP_CACHE`` nor beside the installed package; either must be private (owned by this user,
 writable by no one else: numba's index files are pickles). When no private writable folder is found the

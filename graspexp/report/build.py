@@ -21,6 +21,7 @@ import pandas as pd
 from graspexp.record import CorruptLogError, read_trial
 from graspexp.report.agreement import Agreement, agreement, agreement_chart, example_trials
 from graspexp.report.charts import success_chart
+from graspexp.report.citations import DETERMINISM
 from graspexp.report.collect import FINGERPRINT_COLUMN, Collected, collect
 from graspexp.report.contact_area import held_in_area
 from graspexp.report.gallery import draw_trial, write_gallery
@@ -134,7 +135,7 @@ def _agreement_display(ag: Agreement, pictures: dict[tuple[str, str, str], str])
     )
 
 
-def _agreement_section(ag: Agreement, results: pd.DataFrame, out: Path) -> list[str]:
+def agreement_section(ag: Agreement, results: pd.DataFrame, out: Path) -> list[str]:
     """Write ``agreement_<dataset>_<planner>.{md,csv,png}`` and a picture of each flagged cell's failure;
     returns the report.md lines."""
     pictures = {}
@@ -197,7 +198,7 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
         md += [f"{i}. {note}" for i, note in enumerate(footnotes(table), 1)]
         md += ["", f"![{table.name}]({table.name}.png)", ""]
     for ag in report.agreements:
-        md += _agreement_section(ag, col.results, out)
+        md += agreement_section(ag, col.results, out)
     if not report.failures.empty:
         (out / "failures.md").write_text(markdown(report.failures, index=False) + "\n")
         (out / "failures.tex").write_text(latex(report.failures, "Failure reasons per setting", index=False))
@@ -276,7 +277,7 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
         counts = col.results[FINGERPRINT_COLUMN].fillna("results.csv only (no log)").value_counts()
         md += ["## Machines and versions", ""]
         md += [
-            "Trial results may depend on the CPU and the libraries (README, Determinism); these logs were made on:",
+            f"Trial results may depend on the CPU and the libraries {DETERMINISM.cite()}; these logs were made on:",
             "",
         ]
         md += [f"- {n} trials: {name}" for name, n in counts.items()] + [""]

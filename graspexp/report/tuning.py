@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pandas as pd
 from scipy.stats import binomtest
@@ -20,6 +21,9 @@ from graspexp.config.job import JobConfig
 from graspexp.report.collect import ran
 from graspexp.report.stats import success_pct
 from graspexp.report.study import SweepStudy, is_log_scale
+
+if TYPE_CHECKING:
+    import optuna
 
 
 @dataclass(frozen=True)
@@ -159,3 +163,18 @@ def tuning_markdown(sweep: SweepStudy, scored: list[ScoredSet], command: str, pn
         "",
     ]
     return "\n".join(out)
+
+
+def scored_trial(study: optuna.Study) -> int | None:
+    """The trial to score beside the baseline: None (the best trial) when a trial beat trial 0 (the
+    config's own values) on the training objects; else, of the complete trials tied with trial 0, the one
+    whose values lie farthest from trial 0's (:func:`_max_factor`): the most different set that trains
+    as well, a fair test of whether the constants matter on held-out objects."""
+    trials = [t for t in study.get_trials(deepcopy=False) if t.state.name == "COMPLETE"]
+    first = study.trials[0]
+    if study.best_trial.number != first.number or first.state.name != "COMPLETE":
+        return None
+    ties = [t for t in trials if t.value == first.value and t.number != first.number]
+    if not ties:
+        return None
+    return max(ties, key=lambda t: (_max_factor(first.params, t.params), -t.number)).number

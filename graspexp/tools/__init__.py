@@ -15,6 +15,7 @@ TOOLS: tuple[str, ...] = (
     "area",
     "config_reference",
     "tune",
+    "results",
     "bench.trials",
     "bench.reproduce",
     "bench.plan_latency",
