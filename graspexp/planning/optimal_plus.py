@@ -47,7 +47,7 @@ Examination stops once ``shortlist`` paths pass 1-3. ``Grasp.n_feasible`` counts
 ``depth_offset_m``, ``noise_pass``, ``com_factor`` and ``edge_excess_m``. ``details`` is an
 :class:`graspexp.planning.details.OptimalPlusDetails`: the paper's intermediates (``costs`` are the paper's,
 inf where removed by the plane test), ``com`` and the ``shortlist`` of the S passing paths
-(:mod:`graspexp.tools.bench.shortlist` simulates each of them).
+(:mod:`graspexp.run.bench.shortlist` simulates each of them).
 """
 
 from dataclasses import dataclass
