@@ -475,3 +475,21 @@ def test_a_trial_that_never_came_to_rest_is_its_own_failure_class(tmp_path: Path
     report = build_report(tmp_path)
     row = report.failures.set_index(["dataset", "mode", "rot"]).loc[("ycb", "collab", "z")]
     assert (row["trials"], row["success"], row["not_at_rest"], row["no_contact"]) == (3, 1, 2, 0)
+
+
+def test_an_object_that_never_ran_is_na_in_the_paper_table_not_zero(tmp_path: Path) -> None:
+    """An unreadable ape (every trial ``error``) once read as 0 % with a delta of -45 and pulled the Average
+    down; it is n/a, out of the Average, and listed as not run."""
+    for obj, reason in (("ape", "error"), ("cat", None)):
+        for i in range(2):
+            path = tmp_path / "run" / "trials" / obj / f"{i:03d}.mcap"
+            with TrialRecorder(path, {"config_yaml": "{}"}) as rec:
+                rec.result(0.0, _result("linemod", obj, "collab", "z", i, reason, 0.05))
+    report = build_report(tmp_path)
+    ape, avg = (
+        _cell(report.tables[0], "Ape", "collab", "z"),
+        _cell(report.tables[0], "Average", "collab", "z"),
+    )
+    assert ape["n"] == 0 and np.isnan(ape["ours_pct"]) and avg["ours_pct"] == 100.0
+    text = write_report(report, tmp_path / "out", gallery_per_reason=0)
+    assert "## Not run (2 trials)" in text and "linemod/optimal/collab/z 'ape': 2 trial(s) not run" in text
