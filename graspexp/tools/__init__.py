@@ -10,10 +10,12 @@ TOOLS: tuple[str, ...] = (
     "readings",
     "benchmark",
     "download",
+    "download_checkpoint",
     "prepare",
     "area",
     "config_reference",
     "tune",
+    "results",
     "bench.trials",
     "bench.reproduce",
     "bench.plan_latency",
@@ -22,5 +24,6 @@ TOOLS: tuple[str, ...] = (
     "bench.compare_runs",
     "bench.plan_grasps",
     "bench.registration",
+    "bench.learned",
 )
 """Every tool: ``python -m graspexp NAME`` runs ``graspexp.tools.NAME.main``."""

@@ -15,7 +15,13 @@ from graspexp.planning import PlanRequest, plan
 from graspexp.planning.collision import cloud_hits, frame_from_axes, lowest_z
 from graspexp.run.job_config import make_ready
 
-PLANNERS = tuple(sorted(n for n, p in load_planners().items() if isinstance(p, LoadedPlanner)))
+PLANNERS = tuple(
+    sorted(
+        n
+        for n, p in load_planners().items()
+        if isinstance(p, LoadedPlanner) and not p.plugin.needs_observation
+    )
+)
 
 
 def _gripper(*overrides: str):

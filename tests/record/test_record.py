@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.cli import graspexp
 from helpers.logs import strictly_valid
 from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory
@@ -477,14 +478,7 @@ def test_iter_trial_logs(tmp_path):
 
 
 def _replay(*args: str) -> subprocess.CompletedProcess:
-    root = Path(__file__).resolve().parents[2]
-    return subprocess.run(
-        [sys.executable, "-m", "graspexp", "replay", *args],
-        capture_output=True,
-        text=True,
-        cwd=root,
-        timeout=120,
-    )
+    return graspexp("replay", *args, timeout=120)
 
 
 def test_replay_prints_timeline(trial_file):
