@@ -36,7 +36,8 @@ def test_camera_table_columns_split_by_registered_pose():
         for trial in range(10):
             rows.append(
                 {"mode": "bin", "rot": "z", "object": "025_mug", "planner": planner, "trial": trial,
-                 "success": trial < (9 if math.isnan(adds) else 7), "pose_adds_mm": adds}
+                 "success": trial < (9 if math.isnan(adds) else 7), "pose_adds_mm": adds,
+                 "trans_mm": 0.0 if math.isnan(adds) else 10.0, "rot_deg": 0.0}
             )  # fmt: skip
     table = setting_table(pd.DataFrame(rows), "bin", "z").set_index("object")
     assert (
