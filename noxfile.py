@@ -1,5 +1,5 @@
 """Sessions CI and developers call: ``nox -s tests``, ``nox -s lint``, ``nox -s docs``, ``nox -s wheel``,
-``nox -s bench``, ``nox -s learned``, ``nox -s reproduce``, ``nox -s slurm``."""
+``nox -s bench``, ``nox -s learned``, ``nox -s reproduce``, ``nox -s results``, ``nox -s slurm``."""
 
 import os
 import shutil
@@ -131,11 +131,13 @@ def wheel(session: nox.Session) -> None:
 
 @nox.session
 def bench(session: nox.Session) -> None:
-    """Planner latency per Table 1 object, the per-phase trial benchmark, then the 720-trial reproduction
+    """Planner latency per Table 1 object, registration accuracy and depth + registration time per Table
+    1/2 object (the camera extra), the per-phase trial benchmark, then the 720-trial reproduction
     (logged, warm collision cache) with 1 and 2 workers; then, where the optional extra ``learned``
     installs, the learned planners' inference time (``bench.learned``)."""
-    session.install("-e", ".")
+    session.install("-e", ".[camera]")
     session.run("python", "-m", "graspexp", "bench.plan_latency", *session.posargs, env=ENV)
+    session.run("python", "-m", "graspexp", "bench.registration", *session.posargs, env=ENV)
     session.run("python", "-m", "graspexp", "bench.trials", *session.posargs, env=ENV)
     session.run("python", "-m", "graspexp", "bench.reproduce", *session.posargs, env=ENV)
     if _install_learned(session):  # the learned planners' inference time, where the extra installs
@@ -197,6 +199,17 @@ def readings(session: nox.Session) -> None:
     start = time.perf_counter()
     session.run("python", "-m", "graspexp", "readings", *session.posargs, env=ENV, external=True)
     session.log(f"readings: {time.perf_counter() - start:.0f} s wall")
+
+
+@nox.session(venv_backend="none")
+def results(session: nox.Session) -> None:
+    """Every results page (``docs/results/``) and the README's results table from runs of this code
+    (``python -m graspexp results``): resumable (run it again after an interruption), progress on stderr.
+    ``nox -s results -- --check`` checks the pages' fingerprints instead; further posargs go to the tool
+    (``--pages index,readme``, ``hydra/launcher=submitit_slurm hydra.launcher.partition=P``)."""
+    start = time.perf_counter()
+    session.run("python", "-m", "graspexp", "results", *session.posargs, env=ENV, external=True)
+    session.log(f"results: {time.perf_counter() - start:.0f} s wall")
 
 
 @nox.session(venv_backend="none")

@@ -26,8 +26,8 @@ def data_root() -> Path:
     return root
 
 
-FINISHED_RUN = ("dataset=primitives", "objects=[can]", "trials=2", "progress=false")
-"""The job of :func:`finished_run`: two logged trials of the primitive can (default mode and rotation)."""
+FINISHED_RUN = ("dataset=primitives", "objects=[can]", "trials=1", "progress=false")
+"""The job of :func:`finished_run`: one logged trial of the primitive can (default mode and rotation)."""
 
 
 @pytest.fixture(scope="session")

@@ -27,8 +27,6 @@ earlier level. The stages of one level import neither each other: objects (``dat
 what exists, side by side; the camera (``perception``) looks at both; planners get what it gives."""
 STAGES = tuple(stage for level in LEVELS for stage in level)
 LEVEL = {stage: i for i, level in enumerate(LEVELS) for stage in level}
-OPTIONAL_STAGES = frozenset({"perception"})
-"""Stages whose package (and tests folder) may be absent: the camera lands in its own branch."""
 STAGE_OF_PACKAGE = {**{s: s for s in STAGES}, "quality": "planning"}
 """Packages that belong to a stage without carrying its name (grasp quality is a planning-side check)."""
 BASE_PACKAGE = "core"
@@ -83,7 +81,7 @@ def test_top_level_holds_only_packages_and_the_entry_point():
     assert modules == ["__init__.py", "__main__.py"], modules
     packages = {p.name for p in PACKAGE.iterdir() if (p / "__init__.py").is_file()}
     expected = {*STAGE_OF_PACKAGE, BASE_PACKAGE, TOOLS_PACKAGE, *TOOL_ALIASES}
-    assert expected - OPTIONAL_STAGES <= packages <= expected, packages
+    assert packages == expected, packages
 
 
 def test_stages_import_one_way():
@@ -138,7 +136,7 @@ def test_planning_loads_neither_hydra_nor_sapien():
 def test_tests_are_laid_out_by_stage():
     tests = Path(__file__).parent
     dirs = {p.name for p in tests.iterdir() if p.is_dir() and not p.name.startswith((".", "_"))} - {"helpers"}
-    assert {*STAGES, TOOLS_PACKAGE} - OPTIONAL_STAGES <= dirs <= {*STAGES, TOOLS_PACKAGE}, dirs
+    assert dirs == {*STAGES, TOOLS_PACKAGE}, dirs
     assert sorted(p.name for p in tests.glob("*.py")) == ["conftest.py", "test_architecture.py"]
 
 

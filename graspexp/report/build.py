@@ -21,10 +21,12 @@ import pandas as pd
 from graspexp.record import CorruptLogError, read_trial
 from graspexp.report.agreement import Agreement, agreement, agreement_chart, example_trials
 from graspexp.report.charts import success_chart
+from graspexp.report.citations import DETERMINISM
 from graspexp.report.collect import FINGERPRINT_COLUMN, Collected, collect
 from graspexp.report.contact_area import held_in_area
 from graspexp.report.gallery import draw_trial, write_gallery
 from graspexp.report.paper import PLANNER_RUNTIME_S
+from graspexp.report.pose_error import success_by_pose_error
 from graspexp.report.render import display_frame, fmt_pct, footnotes, latex, markdown
 from graspexp.report.tables import (
     IN_AREA_COLUMN,
@@ -60,7 +62,8 @@ def build_report(root: Path | str, progress: bool = True) -> Report:
     df[IN_AREA_COLUMN] = held_in_area(df, progress)
     tables = success_tables(df)
     agreements = [a for a in map(agreement, tables) if a is not None]
-    return Report(col, tables, failure_breakdown(df), runtime_table(df), strict_table(df), agreements)
+    outcomes = pd.concat([df, col.not_run], ignore_index=True)  # counts: the not-run trials as `error`
+    return Report(col, tables, failure_breakdown(outcomes), runtime_table(df), strict_table(df), agreements)
 
 
 def _runtime_display(rt: pd.DataFrame) -> pd.DataFrame:
@@ -94,6 +97,23 @@ def _unreadable_section(col: Collected) -> list[str]:
     return [*lines, ""]
 
 
+def _not_run_section(col: Collected) -> list[str]:
+    """The trials that ended in ``error``, per object and setting: not run, so in no table or average."""
+    if col.not_run.empty:
+        return []
+    lines = [
+        f"## Not run ({len(col.not_run)} trials)",
+        "",
+        "These trials ended in an error (an object that could not be used, a trial that raised); they are "
+        "in no success rate, average or paper comparison above (an object without a run trial shows n/a).",
+        "",
+    ]
+    for key, group in col.not_run.groupby(["dataset", "planner", "mode", "rot", "object"], sort=False):
+        why = str(group["error"].iloc[0]).splitlines()[0] if "error" in group else ""
+        lines.append(f"- {'/'.join(key[:4])} {key[4]!r}: {len(group)} trial(s) not run: {why}")
+    return [*lines, ""]
+
+
 def _agreement_display(ag: Agreement, pictures: dict[tuple[str, str, str], str]) -> pd.DataFrame:
     c = ag.cells
     return pd.DataFrame(
@@ -115,7 +135,7 @@ def _agreement_display(ag: Agreement, pictures: dict[tuple[str, str, str], str])
     )
 
 
-def _agreement_section(ag: Agreement, results: pd.DataFrame, out: Path) -> list[str]:
+def agreement_section(ag: Agreement, results: pd.DataFrame, out: Path) -> list[str]:
     """Write ``agreement_<dataset>_<planner>.{md,csv,png}`` and a picture of each flagged cell's failure;
     returns the report.md lines."""
     pictures = {}
@@ -162,7 +182,8 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
     md = [
         f"# graspexp report: {col.root}",
         "",
-        f"{n_logs} trial logs found, {len(col.results)} results read.",
+        f"{n_logs + len(col.not_run)} trial logs found, {len(col.results)} results read"
+        + (f", {len(col.not_run)} trials not run (listed below)." if len(col.not_run) else "."),
         "",
     ]
     for table in report.tables:
@@ -177,7 +198,7 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
         md += [f"{i}. {note}" for i, note in enumerate(footnotes(table), 1)]
         md += ["", f"![{table.name}]({table.name}.png)", ""]
     for ag in report.agreements:
-        md += _agreement_section(ag, col.results, out)
+        md += agreement_section(ag, col.results, out)
     if not report.failures.empty:
         (out / "failures.md").write_text(markdown(report.failures, index=False) + "\n")
         (out / "failures.tex").write_text(latex(report.failures, "Failure reasons per setting", index=False))
@@ -186,6 +207,18 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
             "## Failure reasons per setting (trial counts)",
             "",
             markdown(report.failures, index=False),
+            "",
+        ]
+    by_error = success_by_pose_error(col.results)
+    if not by_error.empty:
+        by_error.to_csv(out / "pose_error.csv", index=False)
+        md += [
+            "## Success against the measured pose error (perception.source=depth)",
+            "",
+            markdown(by_error, index=False),
+            "",
+            "Trials whose pose was registered from the simulated depth camera, binned by ADD-S of the "
+            "registered pose (mm); success rate with its Wilson 95 % interval.",
             "",
         ]
     if not report.strict.empty:
@@ -236,6 +269,7 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
             "reason, drawn from their logs at the close and at the end (`gallery/*.png`).",
             "",
         ]
+    md += _not_run_section(col)
     md += _unreadable_section(col)
     if col.unreadable:
         pd.DataFrame(col.unreadable, columns=["path", "reason"]).to_csv(out / "unreadable.csv", index=False)
@@ -243,7 +277,7 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
         counts = col.results[FINGERPRINT_COLUMN].fillna("results.csv only (no log)").value_counts()
         md += ["## Machines and versions", ""]
         md += [
-            "Trial results may depend on the CPU and the libraries (README, Determinism); these logs were made on:",
+            f"Trial results may depend on the CPU and the libraries {DETERMINISM.cite()}; these logs were made on:",
             "",
         ]
         md += [f"- {n} trials: {name}" for name, n in counts.items()] + [""]

@@ -12,7 +12,7 @@ import pandas as pd
 from graspexp.report.area_axes import area_axes_frame
 from graspexp.report.collect import collect
 from graspexp.report.contact_area import held_in_area
-from graspexp.report.paper import PAPER_TABLES, SETTINGS
+from graspexp.report.paper import PAPER_TABLES, SETTING_LABELS, SETTINGS
 from graspexp.report.render import SHORT, fmt_ci, fmt_paper, fmt_pct, markdown
 from graspexp.report.tables import AVERAGE, AVERAGE_SAME, IN_AREA_COLUMN, success_table
 
@@ -218,3 +218,29 @@ def _area_axes_section(df: pd.DataFrame, out: Path) -> list[str]:
         markdown(disp, index=False),
         "",
     ]
+
+
+def reading_averages(entries: dict[str, tuple[Path, str]]) -> pd.DataFrame:
+    """The averages of :func:`readings_frame` of the reading directories ``entries`` (name -> (directory,
+    description)), without the in-area criterion (no log is read twice)."""
+    return readings_frame({n: (_results(n, root), what) for n, (root, what) in entries.items()})[0]
+
+
+def beside_paper(avg: pd.DataFrame, reading: str, label: str) -> str:
+    """A Markdown table, one row per paper setting: ``reading``'s success (%) on each dataset (columns
+    named by ``label``) beside the paper's average over the same objects."""
+    sub = avg[avg["reading"] == reading]
+    order = list(PAPER_TABLES)
+    datasets = sorted(
+        dict.fromkeys(sub["dataset"]), key=lambda d: (order.index(d) if d in order else len(order), d)
+    )
+    rows = []
+    for mode, rot in SETTINGS:
+        row = {"setting": SETTING_LABELS[(mode, rot)]}
+        for dataset in datasets:
+            cell = sub[(sub["dataset"] == dataset) & (sub["mode"] == mode) & (sub["rot"] == rot)]
+            name = {"ycb": "YCB", "linemod": "LINEMOD"}.get(dataset, dataset)
+            row[f"{name} {label}"] = fmt_pct(cell["ours_pct"].iloc[0]) if len(cell) else "n/a"
+            row[f"{name} paper"] = fmt_paper(cell["paper_same_pct"].iloc[0]) if len(cell) else "—"
+        rows.append(row)
+    return markdown(pd.DataFrame(rows), index=False)

@@ -12,13 +12,18 @@ from __future__ import annotations
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pandas as pd
 from scipy.stats import binomtest
 
 from graspexp.config.job import JobConfig
+from graspexp.report.collect import ran
 from graspexp.report.stats import success_pct
 from graspexp.report.study import SweepStudy, is_log_scale
+
+if TYPE_CHECKING:
+    import optuna
 
 
 @dataclass(frozen=True)
@@ -44,6 +49,10 @@ OBJECTIVE_WORDS = {
 
 
 def _rate(df: pd.DataFrame) -> str:
+    """Success of the trials that ran (:func:`graspexp.report.collect.ran`; "not run" when none did)."""
+    df = ran(df)
+    if df.empty:
+        return "not run"
     k, n = int(df["success"].sum()), len(df)
     pct, lo, hi = success_pct(k, n)
     return f"{pct:.1f} % [{lo:.1f}, {hi:.1f}] ({k}/{n})"
@@ -59,6 +68,7 @@ def paired_test(a: pd.DataFrame, b: pd.DataFrame) -> tuple[int, int, float]:
     """(trials only ``a`` won, trials only ``b`` won, McNemar's exact two-sided p-value), matching trials
     by (object, trial); p is 1 when no trial differs."""
     keys = ["object", "trial"]
+    a, b = ran(a), ran(b)  # a trial not run in either set is no win for the other
     m = a[keys + ["success"]].merge(b[keys + ["success"]], on=keys, suffixes=("_a", "_b"))
     only_a = int((m["success_a"] & ~m["success_b"]).sum())
     only_b = int((~m["success_a"] & m["success_b"]).sum())
@@ -140,7 +150,7 @@ def tuning_markdown(sweep: SweepStudy, scored: list[ScoredSet], command: str, pn
         out.append(f"| {obj} | {' | '.join(cells)} |")
     out.append(f"| **all objects** | {' | '.join(f'**{_rate(s.results)}**' for s in scored)} |")
     only_base, only_tuned, p = paired_test(baseline.results, tuned.results)
-    gain = 100.0 * (tuned.results["success"].mean() - baseline.results["success"].mean())
+    gain = 100.0 * (ran(tuned.results)["success"].mean() - ran(baseline.results)["success"].mean())
     out += [
         "",
         f"- {tuned.label} minus {baseline.label}: {gain:+.1f} percentage points; trials only {baseline.label} "
@@ -153,3 +163,18 @@ def tuning_markdown(sweep: SweepStudy, scored: list[ScoredSet], command: str, pn
         "",
     ]
     return "\n".join(out)
+
+
+def scored_trial(study: optuna.Study) -> int | None:
+    """The trial to score beside the baseline: None (the best trial) when a trial beat trial 0 (the
+    config's own values) on the training objects; else, of the complete trials tied with trial 0, the one
+    whose values lie farthest from trial 0's (:func:`_max_factor`): the most different set that trains
+    as well, a fair test of whether the constants matter on held-out objects."""
+    trials = [t for t in study.get_trials(deepcopy=False) if t.state.name == "COMPLETE"]
+    first = study.trials[0]
+    if study.best_trial.number != first.number or first.state.name != "COMPLETE":
+        return None
+    ties = [t for t in trials if t.value == first.value and t.number != first.number]
+    if not ties:
+        return None
+    return max(ties, key=lambda t: (_max_factor(first.params, t.params), -t.number)).number

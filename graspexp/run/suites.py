@@ -60,7 +60,7 @@ READINGS: tuple[Reading, ...] = (
     Reading(
         "in_area",
         ("planner=optimal_in_area",),
-        "optimal_in_area: every pad contact in the grasping area, object axis (the default until Dec 2026)",
+        "optimal_in_area: every pad contact in the grasping area, object axis",
     ),
     Reading(
         "literal", ("planner=optimal_literal",), "the paper as printed (conf/planner/optimal_literal.yaml)"
@@ -122,6 +122,11 @@ PLANNERS: tuple[Reading, ...] = (
         "antipodal_area",
         ("planner=antipodal_area",),
         "antipodal sampling inside the grasping area",
+    ),
+    Reading(
+        "antipodal_area_pads",
+        ("planner=antipodal_area_pads",),
+        "antipodal sampling held to optimal_plus's area rule: every pad contact in the area",
     ),
     Reading("obb", ("planner=obb",), "top-down across the bounding box's short side"),
 )
@@ -198,18 +203,26 @@ ABLATIONS: tuple[Reading, ...] = (
 ALL: dict[str, Reading] = {r.name: r for r in (*READINGS, *PLANNERS, *ABLATIONS)}
 
 
-def reading_sweep(reading: Reading, out: Path, overrides: tuple[str, ...] | list[str] = ()) -> list[str]:
-    """The multirun that runs one reading on the paper's four settings into ``out/<name>``: Tables 1 and 2
-    at the paper's trial count unless ``overrides`` give ``dataset=`` or ``trials=`` (any other override
-    goes to every job too)."""
-    given = {o.split("=", 1)[0] for o in overrides}
+def reading_sweep(
+    reading: Reading,
+    out: Path,
+    overrides: tuple[str, ...] | list[str] = (),
+    sweep_dir: Path | None = None,
+) -> list[str]:
+    """The multirun that runs one reading on the paper's four settings into ``out/<name>`` (or
+    ``sweep_dir``): Tables 1 and 2 at the paper's trial count with the joblib launcher, unless the
+    reading's overrides or ``overrides`` give ``dataset=``, ``trials=`` or ``hydra/launcher=`` (any other
+    override goes to every job too; ``overrides`` come last and win)."""
+    given = {o.split("=", 1)[0] for o in (*reading.overrides, *overrides)}
     defaults = [
         o
         for o in (sweep_values("dataset", PAPER_DATASETS), f"trials={TRIALS_PER_SETTING}")
         if o.split("=", 1)[0] not in given
     ]
     return multirun_command(
-        out / reading.name, [*SETTINGS_SWEEP, *defaults, "progress=false", *reading.overrides, *overrides]
+        sweep_dir if sweep_dir is not None else out / reading.name,
+        [*SETTINGS_SWEEP, *defaults, "progress=false", *reading.overrides, *overrides],
+        **({"launcher": ()} if "hydra/launcher" in given else {}),
     )
 
 

@@ -15,6 +15,7 @@ TOOLS: tuple[str, ...] = (
     "area",
     "config_reference",
     "tune",
+    "results",
     "bench.trials",
     "bench.reproduce",
     "bench.plan_latency",
@@ -22,6 +23,7 @@ TOOLS: tuple[str, ...] = (
     "bench.shortlist",
     "bench.compare_runs",
     "bench.plan_grasps",
+    "bench.registration",
     "bench.learned",
 )
 """Every tool: ``python -m graspexp NAME`` runs ``graspexp.tools.NAME.main``."""

@@ -1,11 +1,10 @@
 """Config tier: every option of every group composes and validates; bad overrides are one clear line."""
 
 import dataclasses
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from helpers.cli import graspexp
 from helpers.config import compose_cfg
 from helpers.objects import write_urdf_gripper
 from omegaconf import OmegaConf
@@ -125,9 +124,7 @@ def test_out_of_range_values_name_the_key(override, message):
     ],
 )
 def test_bad_override_is_one_line_and_exit_2(args, line):
-    proc = subprocess.run(
-        [sys.executable, "-m", "graspexp", *args], cwd=REPO, capture_output=True, text=True, timeout=60
-    )
+    proc = graspexp(*args)
     assert proc.returncode == 2
     assert proc.stderr.strip() == line
     assert "Traceback" not in proc.stderr
@@ -135,9 +132,7 @@ def test_bad_override_is_one_line_and_exit_2(args, line):
 
 def test_cfg_job_prints_the_composed_config():
     args = ["--cfg", "job", "mode=bin", "rot=xyz", "dataset=linemod", "gripper=robotiq_2f85"]
-    proc = subprocess.run(
-        [sys.executable, "-m", "graspexp", *args], cwd=REPO, capture_output=True, text=True, timeout=60
-    )
+    proc = graspexp(*args)
     assert proc.returncode == 0, proc.stderr
     assert "name: robotiq_2f85" in proc.stdout and "max_width_m: 0.085" in proc.stdout
     assert "name: linemod" in proc.stdout and "pull_back_m: 0.1" in proc.stdout

@@ -44,3 +44,8 @@ def one_error_line(proc: subprocess.CompletedProcess, prefix: str = "graspexp: e
     lines = [ln for ln in proc.stderr.splitlines() if ln.startswith(prefix)]
     assert len(lines) == 1, proc.stderr[-3000:]
     return lines[0]
+
+
+def run_job(run_dir: Path, *overrides: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess:
+    """The job of ``overrides`` into ``run_dir`` (``hydra.run.dir``), without a progress bar."""
+    return graspexp("progress=false", f"hydra.run.dir={run_dir}", *overrides, env=env)

@@ -6,6 +6,7 @@ from omegaconf import OmegaConf
 
 from graspexp.config import CostConfig, GripperConfig, OptimalConfig
 from graspexp.config.compose import compose_config
+from graspexp.perception import Observation
 from graspexp.planning import PlanRequest
 
 RG2 = GripperConfig(
@@ -107,3 +108,15 @@ def resting_cloud(mesh: trimesh.Trimesh, n: int = 768, seed: int = 0) -> tuple[n
     pts, faces = trimesh.sample.sample_surface_even(mesh, n, seed=seed)
     pts = pts + np.array([0.0, 0.0, TABLE_Z - mesh.bounds[0, 2]])
     return pts, mesh.face_normals[faces]
+
+
+def full_view(points: np.ndarray, normals: np.ndarray) -> Observation:
+    """An observation in which the camera saw the whole cloud (no views, every point the target, id 1):
+    lets the planners that read ``PlanRequest.observation`` take part in the contract tests."""
+    return Observation(
+        views=(),
+        points=np.asarray(points, dtype=float),
+        normals=np.asarray(normals, dtype=float),
+        point_ids=np.ones(len(points), dtype=np.int32),
+        target_id=1,
+    )

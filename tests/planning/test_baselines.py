@@ -7,6 +7,7 @@ import trimesh
 from helpers.planning import (  # RG2: explicit dimensions, independent of conf/gripper
     RG2,
     TABLE_Z,
+    full_view,
     plain_cfg,
     resting_cloud,
 )
@@ -32,7 +33,19 @@ over each (planners that read the camera have their own tests)."""
 def _request(planner: str, pts, normals, mode: str = "bin", seed: int = 3, area=None) -> PlanRequest:
     cfg = plain_cfg(planner, mode)
     mask = np.ones(len(pts), bool) if area is None else area
-    return PlanRequest(pts, normals, mask, np.eye(4), TABLE_Z, mode, cfg.gripper, cfg.planner, cfg.cost, seed)
+    return PlanRequest(
+        pts,
+        normals,
+        mask,
+        np.eye(4),
+        TABLE_Z,
+        mode,
+        cfg.gripper,
+        cfg.planner,
+        cfg.cost,
+        seed,
+        observation=full_view(pts, normals),
+    )
 
 
 def _shapes() -> dict[str, trimesh.Trimesh]:
@@ -104,6 +117,7 @@ def test_contract_on_a_primitive(name: str) -> None:
         cfg.planner,
         cfg.cost,
         11,
+        observation=full_view(pts + pose[:3, 3], model.normals @ pose[:3, :3].T),
     )
     _check_contract(req, name)
 

@@ -1,11 +1,10 @@
 """The planner on every real mesh of the shared data root (skipped without it), plus its CLIs."""
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from helpers.cli import graspexp
 from helpers.planning import IN_AREA, PAPER_STEPS_ONLY, RG2, UPRIGHT_SUPPORT_Z, upright_request
 
 from graspexp.config import DatasetConfig, OptimalConfig
@@ -99,12 +98,7 @@ def test_plan_cli_prints_one_json_object_and_dumps(tmp_path, capsys, monkeypatch
 
 @pytest.mark.slow
 def test_plan_cli_unknown_object_is_one_line_and_non_zero():
-    proc = subprocess.run(
-        [sys.executable, "-m", "graspexp", "plan", "dataset=primitives", "objects=[teapot]"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    proc = graspexp("plan", "dataset=primitives", "objects=[teapot]", timeout=120)
     assert proc.returncode == 2
     assert proc.stdout == ""
     lines = proc.stderr.strip().splitlines()

@@ -6,6 +6,7 @@ import pytest
 import trimesh
 from helpers.config import compose_cfg
 from helpers.objects import write_urdf_gripper
+from helpers.planning import full_view
 from omegaconf import OmegaConf
 
 from graspexp.config.plugins import LoadedPlanner, load_planners
@@ -78,7 +79,17 @@ def test_every_planner_plans_with_a_urdf_gripper(tmp_path, planner):
     pts = pts + [0.0, 0.0, 0.1 + 0.06]
     normals = mesh.face_normals[faces]
     req = PlanRequest(
-        pts, normals, np.ones(len(pts), bool), np.eye(4), 0.1, "bin", cfg.gripper, cfg.planner, cfg.cost, 3
+        pts,
+        normals,
+        np.ones(len(pts), bool),
+        np.eye(4),
+        0.1,
+        "bin",
+        cfg.gripper,
+        cfg.planner,
+        cfg.cost,
+        3,
+        observation=full_view(pts, normals),
     )
     grasp = plan(req).grasp
     assert np.isfinite(grasp.pose).all() and 0.0 <= grasp.width_m <= cfg.gripper.max_width_m

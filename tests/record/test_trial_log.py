@@ -1,11 +1,10 @@
 """The main job end to end: per-trial MCAP logs, deterministic payloads, replay and re-simulation."""
 
 import json
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from helpers.cli import graspexp, run_job
 from helpers.config import compose_cfg
 from helpers.logs import strictly_valid
 from mcap.reader import make_reader
@@ -20,18 +19,13 @@ WALL_CLOCK_KEYS = {"timings_s"}
 """Result fields that hold wall-clock time: the only payload bytes allowed to differ between two runs."""
 
 
-def _run_job(run_dir: Path, *overrides: str) -> subprocess.CompletedProcess:
-    cmd = [sys.executable, "-m", "graspexp", "progress=false", f"hydra.run.dir={run_dir}", *overrides]
-    return subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, timeout=300)
-
-
 @pytest.fixture(scope="module")
 def two_runs(tmp_path_factory):
     base = tmp_path_factory.mktemp("job")
     overrides = ("mode=bin", "rot=xyz", "trials=2", "objects=[can,box]")
     runs = [base / "a", base / "b"]
     for d in runs:
-        proc = _run_job(d, *overrides)
+        proc = run_job(d, *overrides)
         assert proc.returncode == 0, proc.stderr[-2000:]
     return runs
 
@@ -84,13 +78,7 @@ def test_same_seed_gives_identical_mcap_payloads(two_runs):
 
 def test_replay_prints_timeline_and_resim_agrees(two_runs):
     path = two_runs[0] / "trials" / "can" / "000.mcap"
-    proc = subprocess.run(
-        [sys.executable, "-m", "graspexp", "replay", str(path), "--resim"],
-        cwd=REPO,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    proc = graspexp("replay", str(path), "--resim", timeout=120)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "approach" in proc.stdout and "reproduced" in proc.stdout
 
@@ -99,13 +87,13 @@ def test_rerun_into_same_directory_resumes_without_rewriting(two_runs):
     run = two_runs[0]
     log = run / "trials" / "can" / "001.mcap"
     before = log.stat().st_mtime_ns
-    proc = _run_job(run, "mode=bin", "rot=xyz", "trials=2", "objects=[can,box]")
+    proc = run_job(run, "mode=bin", "rot=xyz", "trials=2", "objects=[can,box]")
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert log.stat().st_mtime_ns == before
 
 
 def test_unknown_object_is_one_clear_error(tmp_path):
-    proc = _run_job(tmp_path, "objects=[teapot]")
+    proc = run_job(tmp_path, "objects=[teapot]")
     assert proc.returncode == 2
     assert proc.stderr.strip().splitlines()[-1].startswith("graspexp: error: unknown object(s) ['teapot']")
 

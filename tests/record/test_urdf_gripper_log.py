@@ -1,11 +1,10 @@
 """A job with a URDF gripper logs its links as triangle meshes on /scene (foxglove.SceneUpdate), each
 frame-locked to its link's /tf frame, and the log passes strict validation."""
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+from helpers.cli import run_job
 from helpers.logs import strictly_valid
 from helpers.objects import write_urdf_gripper
 
@@ -20,9 +19,15 @@ REPO = Path(__file__).resolve().parents[2]
 def test_the_log_shows_the_urdf_gripper_meshes(tmp_path):
     urdf = write_urdf_gripper(tmp_path)
     run = tmp_path / "run"
-    cmd = [sys.executable, "-m", "graspexp", "progress=false", f"hydra.run.dir={run}", "dataset=primitives"]
-    cmd += ["objects=[can]", "trials=1", "mode=bin", "gripper=urdf", f"gripper.urdf={urdf}"]
-    proc = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, timeout=300)
+    proc = run_job(
+        run,
+        "dataset=primitives",
+        "objects=[can]",
+        "trials=1",
+        "mode=bin",
+        "gripper=urdf",
+        f"gripper.urdf={urdf}",
+    )
     assert proc.returncode == 0, proc.stderr[-2000:]
     (path,) = list(iter_trial_logs(run))
     with open(path, "rb") as f:

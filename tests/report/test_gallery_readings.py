@@ -1,12 +1,11 @@
 """The failure gallery and the readings table, from real trial logs of two small runs (one per reading)."""
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
+from helpers.cli import ok, run_job
 
 from graspexp.record import read_trial
 from graspexp.report import collect
@@ -21,17 +20,7 @@ OBJECTS = "objects=[box,block,mug]"
 
 
 def _run(run_dir: Path, *overrides: str) -> None:
-    cmd = [
-        sys.executable,
-        "-m",
-        "graspexp",
-        "progress=false",
-        f"hydra.run.dir={run_dir}",
-        "trials=2",
-        OBJECTS,
-    ]
-    proc = subprocess.run([*cmd, *overrides], cwd=REPO, capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stderr[-2000:]
+    ok(run_job(run_dir, "trials=2", OBJECTS, *overrides))
 
 
 @pytest.fixture(scope="module")

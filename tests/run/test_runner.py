@@ -6,13 +6,11 @@ Each end-to-end test runs the real CLI on the offline primitives dataset with on
 """
 
 import os
-import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
+from helpers.cli import one_error_line, run_job
 from helpers.config import compose_cfg
 from helpers.logs import foreign_log
 from omegaconf import OmegaConf
@@ -31,33 +29,10 @@ REPO = Path(__file__).resolve().parents[2]
 BASE = ("objects=[can]", "trials=1")
 
 
-def _run_job(run_dir: Path, *overrides: str) -> subprocess.CompletedProcess:
-    cmd = [sys.executable, "-m", "graspexp", "progress=false", f"hydra.run.dir={run_dir}", *overrides]
-    env = {**os.environ, "OMP_NUM_THREADS": "1"}
-    return subprocess.run(cmd, cwd=REPO, env=env, capture_output=True, text=True, timeout=300)
-
-
-def _error_line(proc: subprocess.CompletedProcess) -> str:
-    assert proc.returncode == 2, proc.stderr[-2000:]
-    assert "Traceback" not in proc.stderr
-    lines = [ln for ln in proc.stderr.splitlines() if ln.startswith("graspexp: error:")]
-    assert len(lines) == 1, proc.stderr
-    return lines[0]
-
-
-@pytest.fixture(scope="module")
-def finished_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    run = tmp_path_factory.mktemp("runner") / "run"
-    proc = _run_job(run, *BASE)
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    return run
-
-
 @pytest.fixture
-def run_copy(finished_run: Path, tmp_path: Path) -> Path:
-    out = tmp_path / "run"
-    shutil.copytree(finished_run, out)
-    return out
+def run_copy(finished_run_copy: Path) -> Path:
+    """A copy of the session's finished run (conftest.FINISHED_RUN: the job of BASE, one trial)."""
+    return finished_run_copy
 
 
 @pytest.mark.slow
@@ -70,7 +45,7 @@ def test_resume_refuses_logs_made_with_another_config(run_copy: Path) -> None:
     before = log.read_bytes()
     assert (run_copy / ".hydra" / "config.yaml").is_file()  # written once the run was accepted
     snapshot = _snapshot(run_copy)
-    line = _error_line(_run_job(run_copy, "mode=bin", "gripper=panda", "seed=7", *BASE))
+    line = one_error_line(run_job(run_copy, "mode=bin", "gripper=panda", "seed=7", *BASE))
     assert _snapshot(run_copy) == snapshot  # nothing written, Hydra's .hydra/ included
     assert line.startswith(f"graspexp: error: {run_copy} holds trial logs made with a different config; ")
     assert "differing keys: gripper.name, mode.name, seed, " in line
@@ -83,7 +58,7 @@ def test_resume_refuses_logs_made_with_another_config(run_copy: Path) -> None:
 def test_resume_ignores_keys_that_do_not_change_a_result(run_copy: Path) -> None:
     log = run_copy / "trials" / "can" / "000.mcap"
     before = log.stat().st_mtime_ns
-    proc = _run_job(run_copy, "objects=[can]", "trials=2", "progress=true", "sim.cache_dir=null")
+    proc = run_job(run_copy, "objects=[can]", "trials=2", "progress=true", "sim.cache_dir=null")
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert log.stat().st_mtime_ns == before
     assert (run_copy / "trials" / "can" / "001.mcap").is_file()
@@ -144,7 +119,7 @@ def test_missing_input_stops_the_job_before_any_trial_is_recorded(
     (tmp_path / "empty").mkdir()
     run = tmp_path / "run"
     args = [o.format(empty=tmp_path / "empty") for o in overrides]
-    line = _error_line(_run_job(run, *args, "trials=1"))
+    line = one_error_line(run_job(run, *args, "trials=1"))
     assert message in line
     assert not (run / "trials").exists() and not (run / "results.csv").exists()
 
@@ -162,7 +137,7 @@ def test_error_trial_is_redone_on_resume(run_copy: Path) -> None:
     with TrialRecorder(path, meta) as rec:
         rec.result(0.0, error.to_dict())
     assert read_result(path)["reason"] == "error"
-    proc = _run_job(run_copy, *BASE)
+    proc = run_job(run_copy, *BASE)
     assert proc.returncode == 0, proc.stderr[-2000:]
     redone = read_result(path)
     assert (redone["reason"], redone["success"]) == (old.reason, old.success)
@@ -179,7 +154,7 @@ def test_foreign_and_damaged_files_in_trials_are_moved_aside_never_reused_or_del
     forged = run_copy / "trials" / "box" / "000.mcap"
     forged.parent.mkdir()
     forged.write_bytes(b"\x89MCAP0\r\n not a log")
-    proc = _run_job(run_copy, "objects=[can]", "trials=2")
+    proc = run_job(run_copy, "objects=[can]", "trials=2")
     assert proc.returncode == 0, proc.stderr[-2000:]
     quarantined = sorted(
         p.relative_to(run_copy / "trials" / ".quarantine")
@@ -193,8 +168,8 @@ def test_foreign_and_damaged_files_in_trials_are_moved_aside_never_reused_or_del
 
 @pytest.mark.slow
 def test_a_rerun_with_fewer_trials_keeps_every_trial_in_the_table(run_copy: Path) -> None:
-    assert _run_job(run_copy, "objects=[can]", "trials=2").returncode == 0
-    assert _run_job(run_copy, "objects=[can]", "trials=1").returncode == 0
+    assert run_job(run_copy, "objects=[can]", "trials=2").returncode == 0
+    assert run_job(run_copy, "objects=[can]", "trials=1").returncode == 0
     assert pd.read_csv(run_copy / "results.csv")["trial"].tolist() == [0, 1]
     assert "|        2 |" in (run_copy / "summary.md").read_text()
 
@@ -203,7 +178,7 @@ def test_a_rerun_with_fewer_trials_keeps_every_trial_in_the_table(run_copy: Path
 def test_second_writer_into_a_locked_directory_is_one_line_naming_the_holder(tmp_path: Path) -> None:
     run = tmp_path / "run"
     with job_lock(run):
-        line = _error_line(_run_job(run, *BASE))
+        line = one_error_line(run_job(run, *BASE))
     assert line.startswith(f"graspexp: error: {run} is in use by another run (pid {os.getpid()} on ")
     assert not (run / "trials").exists()
 
@@ -212,7 +187,7 @@ def test_second_writer_into_a_locked_directory_is_one_line_naming_the_holder(tmp
 def test_unwritable_output_folder_is_one_line(tmp_path: Path) -> None:
     blocker = tmp_path / "file"
     blocker.write_text("")
-    line = _error_line(_run_job(blocker / "run", *BASE))
+    line = one_error_line(run_job(blocker / "run", *BASE))
     assert (
         line
         == f"graspexp: error: cannot write the output directory {blocker / 'run'}: {blocker} is not a directory"
@@ -220,7 +195,7 @@ def test_unwritable_output_folder_is_one_line(tmp_path: Path) -> None:
     run = tmp_path / "run"
     run.mkdir()
     (run / "trials").write_text("")  # the trials folder cannot be made
-    line = _error_line(_run_job(run, *BASE))
+    line = one_error_line(run_job(run, *BASE))
     assert (
         line
         == f"graspexp: error: cannot write the trial log {run / 'trials' / 'can' / '000.mcap'}: Not a directory"

@@ -5,13 +5,13 @@ naming the task and the fix, exit status 2, and the trials it finished stay for 
 import os
 import signal
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
 
 from graspexp.run.launchers import task_failure
+from graspexp.run.multirun import multirun_command
 
 pytestmark = pytest.mark.slow
 REPO = Path(__file__).resolve().parents[2]
@@ -28,8 +28,8 @@ def test_submitit_messages_become_one_line() -> None:
 
 def test_a_killed_local_task_ends_the_sweep_in_one_line(tmp_path: Path) -> None:
     out = tmp_path / "sweep"
-    cmd = [sys.executable, "-m", "graspexp", "-m", "mode=bin", "rot=z", "dataset=primitives", "objects=[can]"]
-    cmd += ["trials=40", "progress=false", "hydra/launcher=submitit_local", f"hydra.sweep.dir={out}"]
+    job = ["mode=bin", "rot=z", "dataset=primitives", "objects=[can]", "trials=40", "progress=false"]
+    cmd = multirun_command(out, job, launcher=["hydra/launcher=submitit_local"])
     proc = subprocess.Popen(cmd, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     job_dir = out / "dataset=primitives,mode=bin,objects=[can],rot=z,trials=40"
     deadline = time.monotonic() + 240

@@ -13,9 +13,11 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from helpers.cli import ok, run
 
 from graspexp.report import collect
 from graspexp.run.jobs import job_dir_name
+from graspexp.run.multirun import multirun_command
 
 REPO = Path(__file__).resolve().parents[2]
 SWEEP = ["mode=collab,bin", "rot=z", "dataset=primitives", "objects=[can,box]", "trials=3", "progress=false"]
@@ -24,7 +26,7 @@ COLUMNS = ["dataset", "planner", "mode", "rot", "object", "trial", "seed", "succ
 
 
 def _cmd(sweep_dir: Path, *extra: str) -> list[str]:
-    return [sys.executable, "-m", "graspexp", "-m", *SWEEP, f"hydra.sweep.dir={sweep_dir}", *extra]
+    return multirun_command(sweep_dir, [*SWEEP, *extra], launcher=())
 
 
 def _env() -> dict[str, str]:
@@ -32,9 +34,7 @@ def _env() -> dict[str, str]:
 
 
 def _run(cmd: list[str], timeout: float = 120) -> subprocess.CompletedProcess:
-    proc = subprocess.run(cmd, cwd=REPO, env=_env(), capture_output=True, text=True, timeout=timeout)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return proc
+    return ok(run(cmd, env={"HYDRA_FULL_ERROR": "1"}, timeout=timeout))
 
 
 def _table(sweep_dir: Path) -> pd.DataFrame:

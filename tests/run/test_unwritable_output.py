@@ -1,6 +1,6 @@
-"""A full disk and read-only output end in one line naming the problem and the fix (exit 2, no traceback),
-and nothing written before is lost or left half-written. Real filesystems: a 1 MiB tmpfs and a read-only
-bind mount, each in a private mount namespace (``unshare -m``; skipped where that is not allowed)."""
+"""Read-only output ends in one line naming the problem and the fix (exit 2, no traceback), and nothing
+written before is changed. A real read-only bind mount in a private mount namespace (``unshare -m``;
+skipped where that is not allowed). The full disk is tests/run/test_disk_full.py."""
 
 import shutil
 import subprocess
@@ -8,8 +8,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
-from graspexp.record import read_trial
 
 pytestmark = pytest.mark.slow
 REPO = Path(__file__).resolve().parents[2]
@@ -42,46 +40,6 @@ def _one_error_line(proc: subprocess.CompletedProcess) -> str:
     lines = [ln for ln in proc.stderr.splitlines() if "error:" in ln]
     assert len(lines) == 1, proc.stderr[-3000:]
     return lines[0]
-
-
-def test_a_full_disk_stops_the_run_in_one_line_and_keeps_every_finished_log(tmp_path: Path) -> None:
-    disk, kept = tmp_path / "disk", tmp_path / "kept"
-    disk.mkdir()
-    run = disk / "run"
-    proc = _namespaced(
-        f"mount -t tmpfs -o size=256k none {disk}",
-        [*JOB, "trials=40", f"hydra.run.dir={run}"],
-        after=f"cp -a {disk}/. {kept}/;",
-    )
-    assert proc.returncode == 2, proc.stderr[-3000:]
-    line = _one_error_line(proc)
-    assert line.startswith(f"graspexp: error: cannot write the trial log {run}/trials/can/")
-    assert line.endswith(
-        "the disk may be full: free space, then run the same command again (finished trials are kept and reused)"
-    )
-    logs = sorted((kept / "run" / "trials" / "can").glob("*"))
-    assert logs and all(p.suffix == ".mcap" for p in logs), logs  # no half-written file left behind
-    assert [read_trial(p).result["trial"] for p in logs] == list(range(len(logs)))
-    before = {p.name: p.read_bytes() for p in logs}
-    again = subprocess.run(  # the same command with space: resumes, the finished logs are reused as they are
-        [*JOB, f"trials={len(logs) + 2}", f"hydra.run.dir={kept / 'run'}"],
-        cwd=REPO,
-        capture_output=True,
-        text=True,
-    )
-    assert again.returncode == 0, again.stderr[-3000:]
-    assert all((kept / "run" / "trials" / "can" / n).read_bytes() == b for n, b in before.items())
-    assert len(list((kept / "run" / "trials" / "can").glob("*.mcap"))) == len(logs) + 2
-
-
-@pytest.fixture(scope="module")
-def finished_run(tmp_path_factory) -> Path:
-    run = tmp_path_factory.mktemp("finished") / "run"
-    proc = subprocess.run(
-        [*JOB, "trials=2", f"hydra.run.dir={run}"], cwd=REPO, capture_output=True, text=True
-    )
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return run
 
 
 def _read_only(folder: Path) -> str:

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from helpers.cli import graspexp as _graspexp
 
 from graspexp.config.registry import group_options
 from graspexp.tools import TOOLS
@@ -14,12 +15,6 @@ from graspexp.tools import TOOLS
 REPO = Path(__file__).resolve().parents[2]
 GRASPEXP_COMMAND = Path(sys.executable).parent / "graspexp"
 """The console script pip installs beside the interpreter."""
-
-
-def _graspexp(*args: str, **kw) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "graspexp", *args], cwd=REPO, capture_output=True, text=True, timeout=60, **kw
-    )
 
 
 def test_help_names_graspexp_and_offers_options_not_schemas():

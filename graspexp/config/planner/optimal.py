@@ -50,7 +50,7 @@ class PaperPathsConfig(PlannerConfig):
     """``pose_axis: area_if_elongated``: the area's main axis is used when the area is at least this many
     times longer along it than across it (ratio of its first two principal standard deviations, dimensionless).
     1.5 is "clearly longer than wide", fixed from the geometry before any run; the Table 1/2 areas'
-    elongations (README, readings) put the mug (1.38) and the LINEMOD can (1.37) nearest below it and the
+    elongations (docs/results/readings.md) put the mug (1.38) and the LINEMOD can (1.37) nearest below it and the
     meat can (1.56) nearest above (its area and object axes agree)."""
     auto_k_stroke_fraction: float = 1.0
     """``k: auto``: K = clamp(ceil(L / (fraction * gripper.max_width_m)), 1, k_max), L = the area's extent

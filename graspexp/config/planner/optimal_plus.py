@@ -43,7 +43,7 @@ class OptimalPlusConfig(PaperPathsConfig, AreaContactConfig):
     closer lies on the pad's edge (``contact_band_m`` 4 mm of contact, 1 mm to spare), which the pads'
     pressure squeezes out along the approach. (0.01, the TCP's depth ``gripper.tcp_from_tip_m``, was the
     first value: it also rejects face contacts on tapered objects, e.g. every in-area grasp of the iron,
-    whose body is widest at the soleplate; the README's optimal_plus table shows both.)"""
+    whose body is widest at the soleplate; docs/results/ablation.md shows both.)"""
     pad_depth_target_m: float = 0.025
     """Pad depth aimed at when several depths pass, m: about a third of the RG2 finger (80 mm), deep
     enough to hold by the pad's face and short of the palm."""
@@ -68,7 +68,7 @@ class OptimalPlusConfig(PaperPathsConfig, AreaContactConfig):
     35-40 N, the other finger's side face at 40-46 N): of 4983 shortlisted grasps simulated one by one
     on the same drops (``python -m graspexp bench.shortlist --trials 5``, every Table 1/2 object and
     setting), 1313 of 1314 with the object nowhere past a pad's plane by the finger edges were held,
-    against 93 % (292 of 314) where it reached 2 mm or more past it (README, "optimal_plus")."""
+    against 93 % (292 of 314) where it reached 2 mm or more past it (docs/results/experiments.md, "The choice by the finger edges (commit fb79eb6)")."""
     edge_clearance_m: float = 0.002
     """Band beside each finger's side faces and beyond its tip face that ``edge_clearance`` examines, m:
     the ``collision_margin_m`` the open fingers keep from the object, and about the 1-2 mm the object

@@ -1,0 +1,181 @@
+"""The results pages ``python -m graspexp results`` regenerates (:data:`PAGES`), one :class:`Page` each:
+its file, its sweeps, how its generated block is rendered and its fingerprint jobs. A new page is one
+more entry here (and a page file holding the generated block's two marker lines,
+:data:`graspexp.report.pages.BEGIN` / :data:`~graspexp.report.pages.END`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+from graspexp.report.build import agreement_section, build_report
+from graspexp.report.gallery import write_gallery
+from graspexp.report.pages import embed
+from graspexp.report.readings import beside_paper, reading_averages, readings_report
+from graspexp.report.study import plot_study, read_sweep_study, study_table
+from graspexp.report.tuning import scored_trial, tuning_markdown
+from graspexp.run.results import Page, PageInput, Sweep
+from graspexp.run.score import score_study
+from graspexp.run.suites import ABLATIONS, ALL, READINGS, Reading
+
+GALLERY_PER_REASON = 1
+"""Failures drawn per dataset, setting and reason in a page's gallery."""
+SCORE_TRIALS = 20
+"""Trials per held-out object when a tuning page scores its study's constants."""
+STUDY = (
+    "hydra/sweeper=study",
+    "mode=bin",
+    "dataset=ycb",
+    "dataset.split=train",
+    "trials=10",
+    "record=false",
+    "cost.angle_weight=tag(log, interval(0.01, 1))",
+    "cost.distance_numerator_mm2=tag(log, interval(2, 200))",
+    "cost.distance_offset_mm2=tag(log, interval(0.1, 10))",
+    "cost.table_beta_divisor=tag(log, interval(0.2, 20))",
+    "cost.table_offset=tag(log, interval(0.005, 0.5))",
+)
+"""An Optuna study of Eq. (1)-(3)'s constants in bin picking on the training objects (docs/guide/tuning.md)."""
+
+
+def _sweeps(names: Sequence[str], extra: tuple[str, ...] = ()) -> tuple[Sweep, ...]:
+    return tuple(Sweep(ALL[n], extra) for n in names)
+
+
+def readings_tables(sweeps: Sequence[Sweep]) -> Callable[[PageInput], str]:
+    """A render function: the readings tables (:func:`graspexp.report.readings.readings_report`) of
+    ``sweeps``, one row per sweep, CSVs in the page's work folder."""
+
+    def render(page: PageInput) -> str:
+        entries = {s.reading.name: (page.runs[s], s.reading.what) for s in sweeps}
+        return embed(readings_report(entries, page.work))
+
+    return render
+
+
+def _with_title(title: str, render: Callable[[PageInput], str]) -> Callable[[PageInput], str]:
+    return lambda page: f"## {title}\n\n{render(page)}"
+
+
+def _joined(*parts: Callable[[PageInput], str]) -> Callable[[PageInput], str]:
+    return lambda page: "\n".join(part(page) for part in parts)
+
+
+def _agreement_and_gallery(sweep: Sweep) -> Callable[[PageInput], str]:
+    """The paper agreement (Fisher's exact test per object cell) of ``sweep``'s runs, and a gallery of
+    its failures, drawn into the page's assets folder."""
+
+    def render(page: PageInput) -> str:
+        report = build_report(page.runs[sweep], progress=False)
+        page.assets.mkdir(parents=True, exist_ok=True)
+        prefix = f"{page.assets.name}/"
+        md = []
+        for ag in report.agreements:
+            text = "\n".join(agreement_section(ag, report.collected.results, page.assets))
+            (page.assets / f"{ag.name}.md").unlink()  # the site links its CSV: every cell
+            md.append(embed(text.replace(f"]({ag.name}.md)", f"]({ag.name}.csv)"), prefix=prefix))
+        gallery = write_gallery(report.collected.results, page.assets, GALLERY_PER_REASON)
+        (page.assets / "gallery.md").unlink()  # the page embeds it
+        md.append("## Failures of `" + sweep.reading.name + "`, one per setting and reason\n")
+        md.append(embed(gallery, shift=2, prefix=prefix))
+        return "\n".join(md)
+
+    return render
+
+
+def _tuning(sweep: Sweep) -> Callable[[PageInput], str]:
+    """The study's report (:func:`graspexp.report.tuning.tuning_markdown`): its trials, the baseline and
+    the scored trial (:func:`graspexp.report.tuning.scored_trial`) on the held-out objects, the plots."""
+
+    def render(page: PageInput) -> str:
+        study_dir = page.runs[sweep]
+        found = read_sweep_study(study_dir)
+        trial = scored_trial(found.study)
+        scored = score_study(found, study_dir, "test", SCORE_TRIALS, (), trial)
+        page.assets.mkdir(parents=True, exist_ok=True)
+        study_table(found.study).to_csv(page.assets / "tuning_trials.csv", index=False)
+        pngs = [p.name for p in plot_study(found.study, page.assets)]
+        command = f"python -m graspexp tune {study_dir} --trials {SCORE_TRIALS}"
+        command += f" --trial {trial}" if trial is not None else ""
+        return embed(tuning_markdown(found, scored, command, pngs), prefix=f"{page.assets.name}/")
+
+    return render
+
+
+def _readme(sweep: Sweep) -> Callable[[PageInput], str]:
+    def render(page: PageInput) -> str:
+        avg = reading_averages({sweep.reading.name: (page.runs[sweep], sweep.reading.what)})
+        return beside_paper(avg, sweep.reading.name, "`optimal`") + "\n"
+
+    return render
+
+
+DEFAULT = Sweep(ALL["default"])
+TABLES = _sweeps(["default", "in_area", "literal"])
+COMPARED = _sweeps(["optimal_plus", "default", "antipodal_area", "antipodal_area_pads", "antipodal", "obb"])
+THIRTY = _sweeps(["optimal_plus", "antipodal_area_pads"], ("trials=30", "record=false"))
+GENERALISATION = _sweeps(
+    ["optimal_plus", "default", "antipodal_area", "antipodal_area_pads", "antipodal"],
+    ("dataset=ycb", "dataset.split=test"),
+)
+ABLATION = tuple(Sweep(r, ("trials=5",)) for r in ABLATIONS)
+STUDY_Z = Sweep(
+    Reading(
+        "tuning_bin_z", (*STUDY, "rot=z", "hydra.sweeper.n_trials=60"), "the constants' study, bin, rot z"
+    ),
+    settings=False,
+)
+STUDY_XYZ = Sweep(
+    Reading("tuning_bin_xyz", (*STUDY, "rot=xyz", "hydra.sweeper.n_trials=40"), "the same study, rot xyz"),
+    settings=False,
+)
+
+PAGES: tuple[Page, ...] = (
+    Page("readme", "README.md", (DEFAULT,), _readme(DEFAULT), (DEFAULT,), admonition=False),
+    Page(
+        "index",
+        "docs/results/index.md",
+        TABLES,
+        _joined(readings_tables(TABLES), _agreement_and_gallery(DEFAULT)),
+        TABLES,
+    ),
+    Page(
+        "readings",
+        "docs/results/readings.md",
+        _sweeps([r.name for r in READINGS]),
+        readings_tables(_sweeps([r.name for r in READINGS])),
+        _sweeps(
+            ["default", "literal", "in_area", "pose_axis_area", "no_swept_check", "k_half_stroke", "tcp_25mm"]
+        ),
+    ),
+    Page(
+        "optimal_plus",
+        "docs/results/optimal_plus.md",
+        (*COMPARED, *THIRTY),
+        _joined(
+            _with_title("Every planner on the same drops", readings_tables(COMPARED)),
+            _with_title("30 drops per object and setting", readings_tables(THIRTY)),
+        ),
+        COMPARED,
+    ),
+    Page(
+        "generalisation",
+        "docs/results/generalisation.md",
+        GENERALISATION,
+        readings_tables(GENERALISATION),
+        GENERALISATION,
+        ("objects=[024_bowl,003_cracker_box]", "trials=1"),
+    ),
+    Page(
+        "ablation",
+        "docs/results/ablation.md",
+        ABLATION,
+        readings_tables(ABLATION),
+        tuple(
+            Sweep(ALL[n], ("trials=5",)) for n in ("plus", "plus_choose_cost", "plus_noise", "default_noise")
+        ),
+    ),
+    Page("tuning", "docs/results/tuning.md", (STUDY_Z,), _tuning(STUDY_Z), (DEFAULT,)),
+    Page("tuning_xyz", "docs/results/xyz/tuning.md", (STUDY_XYZ,), _tuning(STUDY_XYZ), (DEFAULT,)),
+)
+"""Every results page, in the order they are regenerated."""

@@ -1,0 +1,376 @@
+"""Results pages made from runs of the current code: ``python -m graspexp results`` regenerates them,
+``python -m graspexp results --check`` tells which ones the code no longer reproduces.
+
+A :class:`Page` (registered in :data:`graspexp.run.result_pages.PAGES`) declares
+
+- its sweeps (:class:`Sweep`: a reading of :mod:`graspexp.run.suites` and extra overrides), each a Hydra
+  multirun over the paper's four settings (:func:`graspexp.run.suites.reading_sweep`, the joblib
+  launcher unless the overrides name another, e.g. ``hydra/launcher=submitit_slurm``);
+- how its generated block is rendered from those runs (``render``, from :mod:`graspexp.report`);
+- its fingerprint jobs: a few trials of the page's own planners and settings (``record=false``), whose
+  outcomes are hashed (:func:`graspexp.report.pages.outcome_fingerprint`) and stamped into the page.
+
+:func:`regenerate` runs every sweep not yet done into ``OUT/runs/<sweep>`` (a sweep two pages share runs
+once; an interrupted regeneration continues: each sweep resumes its own trials, and a finished sweep is
+marked and skipped), then the fingerprint jobs, then writes each page's block. :func:`check` re-runs the
+fingerprint jobs into a temporary folder and compares each page's stamp.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import datetime
+import hashlib
+import io
+import json
+import os
+import platform
+import resource
+import shlex
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from graspexp.report.pages import (
+    Provenance,
+    duration,
+    outcome_fingerprint,
+    provenance,
+    read_stamp,
+    replace_block,
+)
+from graspexp.run.multirun import multirun_command
+from graspexp.run.suites import Reading, reading_sweep
+
+FINGERPRINT_SETTINGS: tuple[tuple[str, str], ...] = (("collab", "z"), ("bin", "xyz"))
+"""(mode, rot) of every fingerprint job: one setting of each mode, the turned drop in bin picking."""
+FINGERPRINT_SUBSET: tuple[str, ...] = ("dataset=ycb", "objects=[025_mug,035_power_drill]", "trials=1")
+"""The default fingerprint objects and trials: two Table 1 objects, one drop each per setting."""
+DONE_NAME = ".graspexp-results-done.json"
+"""Marker a finished sweep leaves in its directory: command, exit status, wall and CPU seconds."""
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """One sweep of a page: a reading (name, overrides, what it is) and overrides beside it (``trials=30``,
+    another dataset or object list), run on the paper's four settings."""
+
+    reading: Reading
+    extra: tuple[str, ...] = ()
+    settings: bool = True
+    """Run on the paper's four settings and both tables (:func:`graspexp.run.suites.reading_sweep`);
+    False: the reading's overrides are the whole sweep (e.g. an Optuna study, ``hydra/sweeper=study``)."""
+
+    @property
+    def name(self) -> str:
+        """The reading's name, and a hash of the extra overrides when there are any."""
+        if not self.extra:
+            return self.reading.name
+        return f"{self.reading.name}-{hashlib.sha256(' '.join(self.extra).encode()).hexdigest()[:8]}"
+
+
+@dataclass(frozen=True)
+class PageInput:
+    """What a page's ``render`` gets: each sweep's directory, a folder for the page's figures (beside the
+    page, ``<page>_files/``, linked as such; the render makes it when it draws) and a work folder for its
+    CSV files (under OUT)."""
+
+    runs: Mapping[Sweep, Path]
+    assets: Path
+    work: Path
+
+
+@dataclass(frozen=True)
+class Page:
+    """A results page: the file it lives in (relative to the repository root), its sweeps, how its
+    generated block is rendered, and the jobs of its fingerprint."""
+
+    name: str
+    path: str
+    sweeps: tuple[Sweep, ...]
+    render: Callable[[PageInput], str]
+    fingerprint: tuple[Sweep, ...]
+    """Sweeps whose outcomes this page's numbers depend on; each runs on :data:`FINGERPRINT_SETTINGS`
+    with ``fingerprint_subset``."""
+    fingerprint_subset: tuple[str, ...] = FINGERPRINT_SUBSET
+    admonition: bool = True
+    """Whether the provenance is a Markdown admonition (the site) or plain paragraphs (the README)."""
+
+
+@dataclass
+class SweepTime:
+    """A finished sweep: its command, exit status, wall and CPU seconds (CPU None: jobs ran elsewhere)."""
+
+    command: str
+    rc: int
+    wall_s: float
+    cpu_s: float | None
+    commit: str = ""
+    """The commit the sweep ran at."""
+    skipped: bool = field(default=False)
+
+
+def merged(*groups: Sequence[str]) -> tuple[str, ...]:
+    """The overrides of ``groups`` in order, a later value of a key replacing an earlier one (in place)."""
+    out: dict[str, str] = {}
+    for group in groups:
+        for o in group:
+            out[o.split("=", 1)[0].lstrip("+~")] = o
+    return tuple(out.values())
+
+
+def fingerprint_jobs(page: Page, overrides: Sequence[str] = ()) -> list[tuple[str, ...]]:
+    """The override lists of ``page``'s fingerprint jobs (``record=false``, no progress bars); the job
+    overrides among ``overrides`` (those given to every sweep; not ``hydra.*``) go to them too, under
+    the page's fingerprint subset."""
+    shared = [o for o in overrides if not o.lstrip("+~").startswith("hydra")]
+    return [
+        merged(
+            s.reading.overrides,
+            s.extra,
+            shared,
+            page.fingerprint_subset,
+            (f"mode={mode}", f"rot={rot}", "record=false", "progress=false"),
+        )
+        for s in page.fingerprint
+        for mode, rot in FINGERPRINT_SETTINGS
+    ]
+
+
+def _job_key(overrides: Sequence[str]) -> str:
+    return hashlib.sha256("\n".join(sorted(overrides)).encode()).hexdigest()[:16]
+
+
+class ResultsError(RuntimeError):
+    """A fingerprint job that cannot run (bad override, missing data): one line naming the job."""
+
+
+def _run_fingerprint_job(overrides: tuple[str, ...], run_dir: str) -> str:
+    """Run one fingerprint job into ``run_dir`` (its printout swallowed); returns its results.csv path."""
+    from graspexp.config import ConfigError
+    from graspexp.config.compose import compose_validated
+    from graspexp.datasets import DatasetError
+    from graspexp.run.locks import RunError
+    from graspexp.run.runner import run_in_dir
+
+    try:
+        cfg = compose_validated(list(overrides))  # run_in_dir makes it ready
+        with contextlib.redirect_stdout(io.StringIO()):
+            run_in_dir(cfg, Path(run_dir))
+    except (ConfigError, DatasetError, RunError) as exc:
+        raise ResultsError(f"the fingerprint job {shlex.join(overrides)} cannot run: {exc}") from None
+    return str(Path(run_dir) / "results.csv")
+
+
+def run_fingerprints(
+    pages: Sequence[Page], out: Path, n_jobs: int, overrides: Sequence[str] = ()
+) -> dict[str, str]:
+    """Run every fingerprint job of ``pages`` (:func:`fingerprint_jobs` with ``overrides``) once (jobs two
+    pages share run once) into ``out`` (emptied first: a fingerprint never reuses a trial) with ``n_jobs``
+    processes; returns each page's fingerprint."""
+    from joblib import Parallel, delayed
+
+    jobs = {_job_key(j): j for page in pages for j in fingerprint_jobs(page, overrides)}
+    shutil.rmtree(out, ignore_errors=True)
+    out.mkdir(parents=True)
+    start = time.perf_counter()
+    print(f"graspexp results: fingerprints: {len(jobs)} jobs ...", file=sys.stderr, flush=True)
+    paths = Parallel(n_jobs=n_jobs)(delayed(_run_fingerprint_job)(j, str(out / k)) for k, j in jobs.items())
+    tables = {k: pd.read_csv(p, dtype=str, keep_default_na=False) for k, p in zip(jobs, paths, strict=True)}
+    print(f"graspexp results: fingerprints: {time.perf_counter() - start:.0f} s", file=sys.stderr)
+    return {
+        page.name: outcome_fingerprint(tables[_job_key(j)] for j in fingerprint_jobs(page, overrides))
+        for page in pages
+    }
+
+
+def _git(root: Path, *args: str) -> str:
+    return subprocess.run(["git", *args], cwd=root, capture_output=True, text=True, check=True).stdout.strip()
+
+
+def commit_of(root: Path) -> tuple[str, str]:
+    """(short commit, its date YYYY-MM-DD) of the checkout at ``root``; ``+changes`` is appended when
+    tracked files differ from the commit."""
+    try:
+        commit = _git(root, "rev-parse", "--short", "HEAD")
+        date = _git(root, "show", "-s", "--format=%cs", "HEAD")
+        changed = _git(root, "status", "--porcelain", "--untracked-files=no")
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown", datetime.date.today().isoformat()
+    return commit + ("+changes" if changed else ""), date
+
+
+def describe_machine() -> str:
+    """What the machine is, in words: cores, architecture, VM or not, CPU model, the physics backend."""
+    from graspexp.run.provenance import machine_fingerprint
+
+    cpu = machine_fingerprint()["cpu"]
+    try:
+        flags = next(
+            (
+                ln.split(":", 1)[1].split()
+                for ln in Path("/proc/cpuinfo").read_text().splitlines()
+                if ln.startswith("flags")
+            ),
+            [],
+        )
+    except OSError:
+        flags = []
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    arch = {"x86_64": "x86-64", "aarch64": "arm64"}.get(platform.machine(), platform.machine())
+    kind = "VM" if "hypervisor" in flags else "machine"
+    return f"a {cores}-core {arch} {kind} ({cpu}), CPU PhysX"
+
+
+def _remote(overrides: Sequence[str]) -> bool:
+    return any(o.startswith("hydra/launcher=submitit_slurm") for o in overrides)
+
+
+def run_sweep(sweep: Sweep, out: Path, overrides: Sequence[str], label: str, commit: str = "") -> SweepTime:
+    """Run (or resume) one sweep into ``out/<sweep.name>`` at ``commit``; a sweep marked done is skipped
+    (with a warning when it was made at another commit: its trials are then not of this code)."""
+    sweep_dir = out / sweep.name
+    marker = sweep_dir / DONE_NAME
+    given = [*sweep.extra, *overrides]
+    if sweep.settings:
+        command = reading_sweep(sweep.reading, out, given, sweep_dir=sweep_dir)
+    else:
+        launcher = {"launcher": ()} if any(o.startswith("hydra/launcher=") for o in given) else {}
+        command = multirun_command(
+            sweep_dir, ["progress=false", *sweep.reading.overrides, *given], **launcher
+        )
+    shown = shlex.join(["python", *command[1:]])
+    if marker.is_file():
+        done = SweepTime(**json.loads(marker.read_text()))
+        print(f"{label} {sweep.name}: done before ({duration(done.wall_s)}), skipped", file=sys.stderr)
+        if done.commit != commit:
+            print(
+                f"{label} {sweep.name}: warning: made at commit {done.commit or 'unknown'}, not {commit}; "
+                "choose another --out to run it with this code",
+                file=sys.stderr,
+            )
+        return dataclasses.replace(done, skipped=True)
+    print(f"{label} {sweep.name}: {sweep.reading.what}\n  {shown}", file=sys.stderr, flush=True)
+    before, start = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
+    rc = subprocess.call(command)
+    after, wall = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter() - start
+    cpu = (
+        None
+        if _remote(overrides)
+        else (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    )
+    result = SweepTime(shown, rc, wall, cpu, commit)
+    print(f"{label} {sweep.name}: {duration(wall)} wall, exit {rc}", file=sys.stderr, flush=True)
+    if rc == 0:
+        marker.write_text(json.dumps({k: v for k, v in vars(result).items() if k != "skipped"}))
+    return result
+
+
+def regenerate(
+    pages: Sequence[Page], root: Path, out: Path, overrides: Sequence[str], command: str, n_jobs: int
+) -> list[str]:
+    """Run the sweeps of ``pages`` (each once, resumable) into ``out/runs``, their fingerprints, and write
+    each page's generated block into its file under ``root``; returns one line per sweep that failed (its
+    pages are then left as they were)."""
+    commit, date = commit_of(root)
+    machine = describe_machine()
+    sweeps = list(dict.fromkeys(s for page in pages for s in page.sweeps))
+    names = {s.name: s for s in sweeps}
+    if len(names) != len(sweeps):
+        raise ValueError("two different sweeps share a name; give their readings different names")
+    times: dict[Sweep, SweepTime] = {}
+    total = time.perf_counter()
+    for i, sweep in enumerate(sweeps, 1):
+        users = ", ".join(p.name for p in pages if sweep in p.sweeps)
+        times[sweep] = run_sweep(sweep, out / "runs", overrides, f"[{i}/{len(sweeps)}] ({users})", commit)
+    failed = {s for s, t in times.items() if t.rc != 0}
+    fingerprints = run_fingerprints(pages, out / "fingerprint", n_jobs, overrides)
+    problems = [f"sweep {s.name} exited {times[s].rc}: {times[s].command}" for s in failed]
+    for page in pages:
+        if failed & set(page.sweeps):
+            problems.append(f"page {page.name} ({page.path}) not written: a sweep of it failed")
+            continue
+        path = root / page.path
+        assets, work = path.parent / f"{path.stem}_files", out / "pages" / page.name
+        own = [times[s] for s in page.sweeps]
+        cpu = None if any(t.cpu_s is None for t in own) else sum(t.cpu_s or 0.0 for t in own)
+        jobs = fingerprint_jobs(page, overrides)
+        head = provenance(
+            Provenance(
+                page=page.name,
+                command=command,
+                commit=commit,
+                date=date,
+                machine=machine,
+                sweeps=tuple(t.command for t in own),
+                wall_s=sum(t.wall_s for t in own),
+                cpu_s=cpu,
+                fingerprint=fingerprints[page.name],
+                fingerprint_trials=_fingerprint_trials(jobs),
+                fingerprint_jobs=tuple(" ".join(j) for j in jobs),
+                sweep_commits=tuple(t.commit or "unknown" for t in own),
+            ),
+            page.admonition,
+        )
+        work.mkdir(parents=True, exist_ok=True)
+        body = page.render(PageInput({s: out / "runs" / s.name for s in page.sweeps}, assets, work))
+        path.write_text(replace_block(path.read_text(), head + "\n" + body, str(path)))
+        print(f"graspexp results: wrote {path}", file=sys.stderr)
+    ran = [t for t in times.values() if not t.skipped]
+    cpu_all = "n/a" if any(t.cpu_s is None for t in ran) else duration(sum(t.cpu_s or 0.0 for t in ran))
+    print(
+        f"graspexp results: {len(ran)} sweeps run now ({len(times) - len(ran)} done before), "
+        f"{duration(time.perf_counter() - total)} wall in all; the sweeps run now {cpu_all} CPU",
+        file=sys.stderr,
+    )
+    return problems
+
+
+def _fingerprint_trials(jobs: Sequence[Sequence[str]]) -> int:
+    """Trials of the fingerprint ``jobs``: objects x trials per job, summed."""
+    from graspexp.datasets import select_objects
+    from graspexp.run.job_config import compose_job
+
+    n = 0
+    for job in jobs:
+        cfg = compose_job(list(job))
+        n += len(select_objects(cfg.dataset, cfg.objects)) * int(cfg.trials)
+    return n
+
+
+def check(pages: Sequence[Page], root: Path, n_jobs: int) -> list[str]:
+    """One line per page of ``pages`` whose recorded fingerprint the current code does not reproduce (or
+    that records none); [] when every page is current."""
+    recorded = {}
+    problems = []
+    for page in pages:
+        path = root / page.path
+        stamp = read_stamp(path.read_text()) if path.is_file() else None
+        if stamp is None or stamp.page != page.name:
+            problems.append(
+                f"{page.path}: no fingerprint of page {page.name!r}: run python -m graspexp results"
+            )
+        else:
+            recorded[page.name] = stamp
+    with tempfile.TemporaryDirectory(prefix="graspexp-results-check-") as tmp:
+        now = run_fingerprints([p for p in pages if p.name in recorded], Path(tmp), n_jobs)
+    for page in pages:
+        stamp = recorded.get(page.name)
+        if stamp is None:
+            continue
+        if now[page.name] != stamp.fingerprint:
+            problems.append(
+                f"{page.path}: made at commit {stamp.commit} (fingerprint {stamp.fingerprint}); the current code "
+                f"gives {now[page.name]}: regenerate it with python -m graspexp results --pages {page.name}"
+            )
+        else:
+            print(f"graspexp results: {page.path}: current ({stamp.fingerprint})", file=sys.stderr)
+    return problems

@@ -1,0 +1,171 @@
+"""``python -m graspexp results``: the page registry, the generated block, the fingerprint, and the
+staleness check, which fails when a planner's code changes and passes otherwise."""
+
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from graspexp.report.pages import (
+    BEGIN,
+    END,
+    PageError,
+    Stamp,
+    outcome_fingerprint,
+    read_stamp,
+    replace_block,
+    stamp,
+)
+from graspexp.run.result_pages import PAGES
+from graspexp.run.results import check, fingerprint_jobs, merged, regenerate
+from graspexp.tools.results import main as results_main
+
+ROOT = Path(__file__).resolve().parents[2]
+
+FAKE_PAGE = """
+from graspexp.run.results import Page, Sweep
+from graspexp.run.suites import Reading
+
+PAGE = Page(
+    "fake",
+    "page.md",
+    (),
+    lambda page: "the tables\\n",
+    (Sweep(Reading("mug", ("planner=optimal",), "the paper's planner on the mug")),),
+    ("dataset=primitives", "objects=[mug]", "trials=1"),
+)
+"""
+"""A page with no sweep and one fingerprint sweep (2 trials on a procedural mug, no data needed)."""
+
+
+def _results(**changes) -> pd.DataFrame:
+    row = {
+        "dataset": "ycb",
+        "object": "025_mug",
+        "mode": "bin",
+        "rot": "z",
+        "planner": "optimal",
+        "trial": "0",
+    }
+    row |= {"success": "True", "grasp_cost": "1.25", "timings_s": "{'plan': 0.1}"}
+    return pd.DataFrame([row | changes])
+
+
+def test_a_fingerprint_hashes_outcomes_not_timings_nor_new_columns():
+    base = outcome_fingerprint([_results()])
+    assert outcome_fingerprint([_results(timings_s="{'plan': 0.2}")]) == base
+    assert outcome_fingerprint([_results(new_field="x")]) == base
+    assert outcome_fingerprint([_results(grasp_cost="1.2500000001")]) != base
+    assert outcome_fingerprint([_results(success="False")]) != base
+    two = [_results(), _results(trial="1")]
+    assert outcome_fingerprint(two) == outcome_fingerprint(two[::-1])
+
+
+def test_the_block_is_replaced_and_its_stamp_read_back(tmp_path: Path):
+    text = f"# Page\n\nBefore.\n\n{BEGIN}\nold\n{END}\n\nAfter.\n"
+    s = Stamp("index", "0123abcd0123abcd", "abc1234")
+    new = replace_block(text, stamp(s) + "\nnew table\n", "page.md")
+    assert new.startswith("# Page\n\nBefore.\n\n") and new.endswith(f"{END}\n\nAfter.\n")
+    assert "old" not in new and "new table" in new
+    assert read_stamp(new) == s and read_stamp(text) is None
+    with pytest.raises(PageError, match="page.md has no generated block"):
+        replace_block("# no markers\n", "x", "page.md")
+
+
+def test_overrides_merge_last_wins_and_pages_are_well_formed():
+    assert merged(["trials=5", "record=false"], ["trials=1", "+x=2"]) == ("trials=1", "record=false", "+x=2")
+    assert len({p.name for p in PAGES}) == len(PAGES)
+    for page in PAGES:
+        text = (ROOT / page.path).read_text()
+        assert BEGIN in text and END in text, page.path
+        jobs = fingerprint_jobs(page)
+        assert jobs and all("record=false" in j for j in jobs), page.name
+    names = {}
+    for page in PAGES:
+        for s in page.sweeps:
+            assert names.setdefault(s.name, s) == s, f"two sweeps named {s.name}"
+
+
+def test_an_unknown_page_is_refused_with_one_line(capsys):
+    with pytest.raises(SystemExit) as exc:
+        results_main(["--check", "--pages", "nope"])
+    assert exc.value.code == 2
+    assert "unknown page(s) ['nope']; the pages are readme, index" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_check_passes_on_the_same_code_and_fails_when_a_planner_changes(tmp_path: Path):
+    (tmp_path / "fake_page.py").write_text(FAKE_PAGE)
+    sys.path.insert(0, str(tmp_path))
+    try:
+        from fake_page import PAGE as page
+    finally:
+        sys.path.remove(str(tmp_path))
+    (tmp_path / "page.md").write_text(f"# Fake\n\n{BEGIN}\n{END}\n")
+    assert regenerate([page], tmp_path, tmp_path / "out", [], "python -m graspexp results", 1) == []
+    text = (tmp_path / "page.md").read_text()
+    assert "the tables" in text and "2 fixed trials" in text and "2 jobs" in text
+    assert check([page], tmp_path, 1) == []
+    script = textwrap.dedent(
+        f"""
+        import sys
+        from pathlib import Path
+
+        import graspexp.planning.optimal as optimal
+        from graspexp.run.results import check
+
+        original = optimal.path_costs
+        optimal.path_costs = lambda *a: original(*a) * 1.01  # a planner constant changed
+        sys.path.insert(0, {str(tmp_path)!r})
+        from fake_page import PAGE
+
+        problems = check([PAGE], Path({str(tmp_path)!r}), 1)
+        print("\\n".join(problems))
+        sys.exit(1 if problems else 0)
+        """
+    )
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert done.returncode == 1, done.stderr[-2000:]
+    assert "page.md: made at commit" in done.stdout and "the current code gives" in done.stdout
+    assert "python -m graspexp results --pages fake" in done.stdout
+
+
+def test_a_sweep_marked_done_is_skipped_and_the_launcher_is_an_override(tmp_path: Path, capsys):
+    from graspexp.run.results import DONE_NAME, Sweep, run_sweep
+    from graspexp.run.suites import ALL, reading_sweep
+
+    sweep = Sweep(ALL["default"], ("trials=3",))
+    (tmp_path / sweep.name).mkdir()
+    (tmp_path / sweep.name / DONE_NAME).write_text(
+        '{"command": "c", "rc": 0, "wall_s": 90.0, "cpu_s": 170.0}'
+    )
+    done = run_sweep(sweep, tmp_path, [], "[1/1]")
+    assert done.skipped and (done.wall_s, done.cpu_s) == (90.0, 170.0)
+    assert f"[1/1] {sweep.name}: done before (90 s), skipped" in capsys.readouterr().err
+    slurm = reading_sweep(
+        ALL["default"], tmp_path, ["hydra/launcher=submitit_slurm", "hydra.launcher.partition=p"]
+    )
+    assert "hydra/launcher=joblib" not in slurm and "hydra/launcher=submitit_slurm" in slurm
+    assert "hydra/launcher=joblib" in reading_sweep(ALL["default"], tmp_path)
+
+
+def test_a_tuning_page_scores_the_best_trial_or_the_farthest_tie():
+    import optuna
+
+    from graspexp.report.tuning import scored_trial
+
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+
+    def study(values: list[tuple[float, float]]) -> optuna.Study:
+        s = optuna.create_study(direction="maximize")
+        dist = {"x": optuna.distributions.LogUniformDistribution(0.01, 100)}
+        for x, v in values:
+            s.add_trial(optuna.trial.create_trial(params={"x": x}, distributions=dist, value=v))
+        return s
+
+    assert scored_trial(study([(1.0, 0.9), (2.0, 0.95), (50.0, 0.9)])) is None  # trial 1 beat the baseline
+    assert scored_trial(study([(1.0, 0.9), (2.0, 0.9), (0.05, 0.9), (30.0, 0.8)])) == 2  # 20x, tied
+    assert scored_trial(study([(1.0, 0.9), (3.0, 0.8)])) is None  # no tie: the best is trial 0 itself
