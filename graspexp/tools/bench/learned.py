@@ -28,7 +28,7 @@ import numpy as np  # noqa: E402
 from omegaconf import OmegaConf  # noqa: E402
 
 from graspexp.core.seeding import trial_seed  # noqa: E402
-from graspexp.datasets import DatasetError, job_object  # noqa: E402
+from graspexp.datasets import DatasetError, job_object, select_objects  # noqa: E402
 from graspexp.planning import NoFeasibleGrasp, PlanRequest, plan  # noqa: E402
 from graspexp.run.upright import UPRIGHT_TRIAL, upright_request  # noqa: E402
 from graspexp.sim.perceive import perceive  # noqa: E402
@@ -65,13 +65,19 @@ def time_plans(req: PlanRequest, runs: int) -> dict[str, np.ndarray]:
     return out
 
 
+def _percentiles_ms(seconds: np.ndarray) -> np.ndarray:
+    """(p50, p95) of ``seconds`` in ms, NaN when every value is NaN (no grasp: the steps are not logged)."""
+    finite = seconds[np.isfinite(seconds)]
+    return np.percentile(finite, [50, 95]) * 1e3 if len(finite) else np.full(2, np.nan)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = tool_parser(PROG, __doc__.split("\n")[0], overrides=True)
     parser.add_argument("--runs", type=int, default=10, help="timed plans per object")
     args = parser.parse_intermixed_args(argv)
     given = {o.split("=")[0] for o in args.overrides}
     cfg = compose_checked([d for d in DEFAULTS if d.split("=")[0] not in given] + args.overrides, PROG)
-    names = list(cfg.objects or cfg.dataset.objects)
+    names = select_objects(cfg.dataset, cfg.objects)
     try:
         requests = [(name, observed_request(cfg, name)) for name in names]
     except DatasetError as err:
@@ -96,13 +102,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     p50s = []
     for name, req in requests:
         t = time_plans(req, args.runs)
-        ms = {k: np.nanpercentile(v, [50, 95]) * 1e3 for k, v in t.items()}
+        ms = {k: _percentiles_ms(v) for k, v in t.items()}
         p50s.append([ms["wall"][0], ms["cpu"][0], ms["infer_cpu_s"][0]])
+        steps = "   (no grasp: steps not logged)" if np.isnan(ms["infer_cpu_s"][0]) else ""
         print(
             f"{name:<26}{ms['wall'][0]:>9.0f}{ms['wall'][1]:>9.0f}{ms['cpu'][0]:>9.0f}{ms['cpu'][1]:>9.0f}"
-            f"{ms['fuse_cpu_s'][0]:>7.0f}{ms['infer_cpu_s'][0]:>7.0f}"
+            f"{ms['fuse_cpu_s'][0]:>7.0f}{ms['infer_cpu_s'][0]:>7.0f}{steps}"
         )
-    wall, cpu, infer = np.median(np.asarray(p50s), axis=0)
+    wall, cpu, infer = np.nanmedian(np.asarray(p50s), axis=0)
     print(
         f"median over objects of the p50: wall {wall:.0f} ms, CPU {cpu:.0f} ms (forward pass {infer:.0f} ms CPU)"
     )
