@@ -9,6 +9,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from graspexp.config.compose import compose_validated
+from graspexp.datasets import select_objects
 from graspexp.report.pages import (
     BEGIN,
     END,
@@ -83,6 +85,9 @@ def test_overrides_merge_last_wins_and_pages_are_well_formed():
         assert BEGIN in text and END in text, page.path
         jobs = fingerprint_jobs(page)
         assert jobs and all("record=false" in j for j in jobs), page.name
+        for job in jobs:  # every job composes and names its objects
+            cfg = compose_validated(list(job))
+            assert select_objects(cfg.dataset, cfg.objects), job
     names = {}
     for page in PAGES:
         for s in page.sweeps:
