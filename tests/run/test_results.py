@@ -85,13 +85,18 @@ def test_overrides_merge_last_wins_and_pages_are_well_formed():
         assert BEGIN in text and END in text, page.path
         jobs = fingerprint_jobs(page)
         assert jobs and all("record=false" in j for j in jobs), page.name
-        for job in jobs:  # every job composes and names its objects
-            cfg = compose_validated(list(job))
-            assert select_objects(cfg.dataset, cfg.objects), job
     names = {}
     for page in PAGES:
         for s in page.sweeps:
             assert names.setdefault(s.name, s) == s, f"two sweeps named {s.name}"
+
+
+@pytest.mark.slow
+def test_every_fingerprint_job_composes_and_names_its_objects():
+    jobs = {tuple(sorted(j)): j for page in PAGES for j in fingerprint_jobs(page)}
+    for job in jobs.values():
+        cfg = compose_validated(list(job))
+        assert select_objects(cfg.dataset, cfg.objects), job
 
 
 def test_an_unknown_page_is_refused_with_one_line(capsys):
