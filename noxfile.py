@@ -1,5 +1,5 @@
 """Sessions CI and developers call: ``nox -s tests``, ``nox -s lint``, ``nox -s docs``, ``nox -s wheel``,
-``nox -s bench``, ``nox -s reproduce``, ``nox -s results``, ``nox -s slurm``."""
+``nox -s bench``, ``nox -s learned``, ``nox -s reproduce``, ``nox -s results``, ``nox -s slurm``."""
 
 import os
 import shutil
@@ -8,12 +8,15 @@ import time
 from pathlib import Path
 
 import nox
+from nox.command import CommandFailed
 
 nox.options.default_venv_backend = "venv"
 nox.options.reuse_existing_virtualenvs = True
 HERE = Path(__file__).parent
 DATA = os.environ.get("GRASPEXP_DATA", str((HERE / ".." / "shared" / "datasets").resolve()))
 ENV = {"GRASPEXP_DATA": DATA, "OMP_NUM_THREADS": "1"}
+CHECKPOINTS = os.environ.get("GRASPEXP_CHECKPOINTS", str((Path(DATA) / ".." / "peers" / "vgn").resolve()))
+"""The published checkpoints the learned planners' tests read (``../shared/peers/vgn``; never copied)."""
 
 
 @nox.session
@@ -21,6 +24,33 @@ def tests(session: nox.Session) -> None:
     """The test suite (real SAPIEN physics) with the shared meshes as data root."""
     session.install("-e", ".[test]")
     session.run("pytest", *session.posargs, env=ENV)
+
+
+def _install_learned(session: nox.Session) -> bool:
+    """Install the optional extra ``learned`` (torch's CPU build, Open3D) and check that it imports; False
+    (with one line saying why) where it cannot be installed or loaded here."""
+    try:
+        session.install("-e", ".[learned]", "-c", "constraints.txt", silent=True)
+        session.run("python", "-c", "import torch, open3d", silent=True)
+    except CommandFailed:
+        session.log(
+            "the optional extra learned cannot be installed or imported here (torch==2.13.0 CPU build, "
+            "open3d-cpu==0.20.0, which needs the system's libusb-1.0: apt-get install libusb-1.0-0)"
+        )
+        return False
+    return True
+
+
+@nox.session
+def learned(session: nox.Session) -> None:
+    """The learned planners' tests (``-m learned``: planner=vgn loads its checkpoint, gives the same outputs
+    every time, plans on a rendered scene) with the optional extra ``learned`` installed; skipped with one
+    line where the extra cannot be installed."""
+    session.install("-e", ".[test]", "-c", "constraints.txt")
+    if not _install_learned(session):
+        session.skip("nox -s learned skipped: the optional extra learned is not available on this machine")
+    env = {**ENV, "GRASPEXP_CHECKPOINTS": CHECKPOINTS}
+    session.run("pytest", "-m", "learned", "-p", "no:cacheprovider", *session.posargs, env=env)
 
 
 @nox.session
@@ -103,12 +133,16 @@ def wheel(session: nox.Session) -> None:
 def bench(session: nox.Session) -> None:
     """Planner latency per Table 1 object, registration accuracy and depth + registration time per Table
     1/2 object (the camera extra), the per-phase trial benchmark, then the 720-trial reproduction
-    (logged, warm collision cache) with 1 and 2 workers."""
+    (logged, warm collision cache) with 1 and 2 workers; then, where the optional extra ``learned``
+    installs, the learned planners' inference time (``bench.learned``)."""
     session.install("-e", ".[camera]")
     session.run("python", "-m", "graspexp", "bench.plan_latency", *session.posargs, env=ENV)
     session.run("python", "-m", "graspexp", "bench.registration", *session.posargs, env=ENV)
     session.run("python", "-m", "graspexp", "bench.trials", *session.posargs, env=ENV)
     session.run("python", "-m", "graspexp", "bench.reproduce", *session.posargs, env=ENV)
+    if _install_learned(session):  # the learned planners' inference time, where the extra installs
+        env = {**ENV, "GRASPEXP_CHECKPOINTS": CHECKPOINTS}
+        session.run("python", "-m", "graspexp", "bench.learned", env=env)
 
 
 @nox.session(venv_backend="none")

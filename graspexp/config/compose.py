@@ -83,6 +83,31 @@ def search_ranges(overrides: Sequence[str]) -> list[str]:
     return [text for text, o in zip(mine, parsed, strict=True) if isinstance(o.value(), IntervalSweep)]
 
 
+def search_problems(overrides: Sequence[str]) -> list[str]:
+    """Why an Optuna study of ``overrides`` could not start, found before Hydra does: a search range whose
+    lower end is not below its upper end (a log range: not above 0), ``hydra.sweeper.n_trials`` not a
+    positive integer. One message per problem, naming the override."""
+    from hydra.core.override_parser.overrides_parser import OverridesParser
+    from hydra.core.override_parser.types import IntervalSweep
+
+    problems = []
+    for text, o in zip(overrides, OverridesParser.create().parse_overrides(list(overrides)), strict=True):
+        value = o.value()
+        if isinstance(value, IntervalSweep):
+            lo, hi = float(value.start), float(value.end)
+            if not lo < hi:
+                problems.append(
+                    f"{text}: the search range's lower end {lo:g} is not below its upper end {hi:g}"
+                )
+            elif "log" in value.tags and not lo > 0:
+                problems.append(f"{text}: a log search range needs a lower end above 0, got {lo:g}")
+        elif o.get_key_element() == "hydra.sweeper.n_trials":
+            n = value if isinstance(value, int) and not isinstance(value, bool) else None
+            if n is None or n < 1:
+                problems.append(f"{text}: the number of trials of a study must be a positive integer")
+    return problems
+
+
 def expand_sweeps(overrides: Sequence[str]) -> list[list[str]]:
     """Every combination of a multirun's overrides (``mode=collab,bin rot=z,xyz`` -> 4 override lists),
     in the order Hydra's basic sweeper launches them; ``hydra.*`` overrides are left out. An Optuna

@@ -43,6 +43,11 @@ class DatasetConfig:
     units: str = "m"
     """``folder`` layout: the units of mesh files whose sidecar sets none: ``m``, ``cm``, ``mm`` or a
     number (the factor from file units to metres)."""
+    max_faces: int = 500_000
+    """Largest mesh an object may have, faces (triangles as read from its file; a URDF object's parts
+    together). Building a collision shape takes minutes from about a million faces (a 2.6M-face scan: 179 s
+    and 4.9 GB); a larger object fails alone with this key named: decimate it first (MeshLab's Quadric Edge
+    Collapse) or raise the cap. Scanned objects need far fewer (google_16k: 16,384)."""
     bop_set: str | None = None
     """``bop`` layout: the BOP set (``lm``, ``lmo``, ``ycbv``, ``tless``, ...) whose human object names to
     use where it defines them; None: the name of the folder (BOP folders are named by set)."""
@@ -57,6 +62,7 @@ CONSTRAINTS = {
     "density_kg_m3": [Interval(0, 25_000, "right", "kg/m^3")],
     "regions": [None, *TEXT],
     "units": [Pattern(r"m|cm|mm|[0-9]*\.?[0-9]+([eE][-+]?[0-9]+)?", "m, cm, mm or a positive number")],
+    "max_faces": [Interval(1, None, integer=True)],
     "bop_set": [None, *TEXT],
 }
 """Allowed values of every key (see :mod:`graspexp.config.constraints`)."""

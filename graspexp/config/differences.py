@@ -6,6 +6,7 @@ import dataclasses
 from omegaconf import DictConfig, OmegaConf
 
 from graspexp.config.constraints import BEFORE
+from graspexp.core.userinput import load_user_yaml
 
 RESULT_NEUTRAL_KEYS = (
     "progress",  # the progress bar
@@ -15,6 +16,7 @@ RESULT_NEUTRAL_KEYS = (
     "dataset.objects",
     "dataset.split",  # which objects run
     "objective",  # what the job returns to a sweeper, computed from the results
+    "dataset.max_faces",  # which objects may run (a larger one is refused), not what a trial gives
     "sim.cache_dir",  # where collision shapes are cached; entries are keyed by mesh content
     "sim.prepare_workers",  # how many processes build the collision shapes, not what they build
     "live",  # whether trials also stream to the Foxglove app
@@ -69,7 +71,10 @@ def result_config(config: dict) -> dict[str, object]:
 def config_differences(recorded_yaml: str, cfg: DictConfig) -> dict[str, tuple[object, object]]:
     """dotted key -> (value in the log, value now) for every key that affects a result and differs; a key
     absent on one side shows as ``<absent>``. A key the log lacks is not a difference when it now has the
-    value the code had before the key was added (:func:`_value_before`)."""
+    value the code had before the key was added (:func:`_value_before`). A recorded config that holds YAML
+    aliases or is too large raises :class:`graspexp.core.userinput.UserInputError` before it is expanded
+    (a log in a shared directory may be anyone's)."""
+    load_user_yaml(recorded_yaml, "the log's recorded config")  # bounded, no alias expands below
     old = _flatten(OmegaConf.to_container(OmegaConf.create(recorded_yaml), resolve=True))
     new = _flatten(OmegaConf.to_container(cfg, resolve=True))
     absent = "<absent>"

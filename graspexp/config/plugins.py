@@ -41,6 +41,9 @@ class PlannerPlugin:
     needs_observation : the planner reads the depth camera's output (``PlanRequest.observation``): the
         trial renders the camera for it even with ``perception.source=truth`` (the camera extra must be
         installed).
+    unavailable : optional ``() -> str``: '' when the planner can run on this machine, else one line
+        naming what is missing and the command that brings it (an optional extra, a checkpoint); called
+        when a config selects the planner, so the run stops before its first trial.
     """
 
     plan: Callable[..., Any] | str
@@ -48,6 +51,7 @@ class PlannerPlugin:
     constraints: Mapping[str, list]
     version: str = ""
     needs_observation: bool = False
+    unavailable: Callable[[], str] | None = None
 
 
 @dataclass(frozen=True)

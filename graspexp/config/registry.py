@@ -25,6 +25,9 @@ SCHEMAS = {
     "sim": SimConfig,
 }
 """The schema of each group with one schema; the ``planner`` group has one per planner (its plugin's)."""
+NESTED_SCHEMAS = {"camera": CameraConfig}
+"""Schemas of the groups nested under a key (``perception/camera``, its options at ``perception.camera``),
+stored as ``schema_<name>``."""
 
 
 def _conf_dir() -> Path:
@@ -70,7 +73,8 @@ def register_configs() -> None:
     cs.store(name=schema_name("job"), node=JobConfig)
     for group, schema in SCHEMAS.items():
         cs.store(name=schema_name(group), node=schema)
-    cs.store(name=schema_name("camera"), node=CameraConfig)  # the group perception/camera
+    for name, schema in NESTED_SCHEMAS.items():
+        cs.store(name=schema_name(name), node=schema)
     presets = _yaml_options("planner")
     for name, found in load_planners().items():
         if isinstance(found, LoadedPlanner):

@@ -29,7 +29,8 @@ class SimConfig:
     object_angular_damping: float = 0.5
     """Angular velocity damping of the object, 1/s: stands in for rolling resistance (PhysX has none)."""
     settle_max_s: float = 3.0
-    """Time cap for the drop to come to rest, s."""
+    """Time cap for the drop to come to rest, s; an object still moving then ends its trial as
+    ``not_at_rest`` (nothing is planned on a moving object)."""
     settle_min_s: float = 0.3
     """The drop is not taken as settled before this time has passed, s (at most ``settle_max_s``)."""
     settle_linear_mps: float = 0.005

@@ -93,6 +93,9 @@ def _check_planner(node: DictConfig) -> None:
     except PluginError as exc:
         raise ConfigError(str(exc)) from None
     _check_node(node, found.plugin.config, "planner.", dict(found.plugin.constraints))
+    why = found.plugin.unavailable() if found.plugin.unavailable is not None else ""
+    if why:
+        raise ConfigError(f"planner={node.name} cannot run here: {why}")
 
 
 def _missing(dotted: str) -> None:

@@ -25,6 +25,10 @@ class FailureReason(str, enum.Enum):
     """NaN or exploding velocities."""
     FELL_OFF_SUPPORT = "fell_off_support"
     """The object fell off the support on every drop of the re-drop budget."""
+    NOT_AT_REST = "not_at_rest"
+    """The object was still moving when the settle time cap (``sim.settle_max_s``) ran out: nothing is
+    planned on a moving object, so the trial is neither a grasp's success nor its failure (the log's
+    ``settle_timeout`` phase says how fast it still moved)."""
     ERROR = "error"
     """The trial raised; the message is in ``TrialResult.error``."""
 
@@ -62,7 +66,7 @@ class TrialResult:
     steps: int = 0
     at_rest: bool = True
     """False when the settle time cap (``sim.settle_max_s``) ran out before the object came to rest: the
-    planner saw a moving object (the log's ``settle_timeout`` phase says how fast it still moved)."""
+    trial then ends as ``not_at_rest`` (logs before that reason existed planned on the moving object)."""
     pose_trans_err_mm: float = float("nan")
     """``perception.source=depth``: distance between the registered and the true object origin, mm (NaN
     when no pose was registered)."""

@@ -13,7 +13,11 @@ A sweep directory holds one run directory per job, its lock ``.graspexp-sweep.lo
 ``.graspexp-failed/`` (one record per failed job).
 """
 
+import errno
+import os
 from pathlib import Path
+
+from graspexp.core.userinput import check_object_name
 
 TRIALS_DIR = "trials"
 """The folder of a run directory that holds its trial logs, ``trials/<object>/<NNN>.mcap``."""
@@ -25,6 +29,8 @@ SUMMARY_MD = "summary.md"
 """The run's per-object success table (markdown)."""
 HYDRA_DIR = ".hydra"
 """Hydra's record of an accepted run: ``config.yaml``, ``hydra.yaml``, ``overrides.yaml``."""
+HYDRA_FILES = ("config.yaml", "hydra.yaml", "overrides.yaml")
+"""The files of :data:`HYDRA_DIR`."""
 LOCK_NAME = ".graspexp.lock"
 """Lock file of a run directory (held while a job writes into it)."""
 SWEEP_LOCK_NAME = ".graspexp-sweep.lock"
@@ -39,8 +45,39 @@ def trials_dir(run_dir: Path | str) -> Path:
 
 
 def trial_log_path(run_dir: Path | str, object_name: str, trial: int) -> Path:
-    """Where trial ``trial`` of ``object_name`` is logged in ``run_dir``."""
-    return trials_dir(run_dir) / object_name / f"{trial:03d}.mcap"
+    """Where trial ``trial`` of ``object_name`` is logged in ``run_dir``; :class:`UserInputError` for a
+    name that is not a valid object name (``..``, ``.quarantine``, a path: it would leave ``trials/``)."""
+    return trials_dir(run_dir) / check_object_name(object_name) / f"{trial:03d}.mcap"
+
+
+class LinkedRunPathError(OSError):
+    """A folder or file of a run directory is a symbolic link (someone else's file would be written); the
+    message is one line naming it."""
+
+
+def real_folder(run_dir: Path | str, folder: Path) -> Path:
+    """``folder`` (``run_dir`` or below it) created where missing, never through a symbolic link: each
+    part below ``run_dir`` must be a real folder (``run_dir`` itself may be a link a user made). Raises
+    :class:`LinkedRunPathError` naming the link (shared sweep directories are written by several people)."""
+    current = Path(run_dir)
+    current.mkdir(parents=True, exist_ok=True)
+    for part in Path(folder).relative_to(current).parts:
+        current = check_not_linked(current / part)
+        if current.exists() and not current.is_dir():
+            raise NotADirectoryError(errno.ENOTDIR, os.strerror(errno.ENOTDIR), str(current))
+        current.mkdir(exist_ok=True)
+    return Path(folder)
+
+
+def check_not_linked(path: Path) -> Path:
+    """``path`` if it is not a symbolic link, else :class:`LinkedRunPathError` (a run file about to be opened
+    or replaced: replacing a link would be safe, writing through one is not)."""
+    if path.is_symlink():
+        raise LinkedRunPathError(
+            f"{path} is a symbolic link; graspexp writes no run file through a link: remove it or choose "
+            "another output directory"
+        )
+    return path
 
 
 def quarantine_path(run_dir: Path | str, log: Path, stamp: str) -> Path:

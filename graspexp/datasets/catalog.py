@@ -22,7 +22,7 @@ from typing import Any
 from graspexp.datasets import bop, folder
 from graspexp.datasets.errors import DatasetError
 from graspexp.datasets.source import MeshPart, ObjectSource
-from graspexp.datasets.ycb_objects import GOOGLE_16K_FACES, YCB_MASS_KG
+from graspexp.datasets.ycb_objects import GOOGLE_16K_EXTENTS_MM, GOOGLE_16K_FACES, YCB_MASS_KG
 
 DATA_ENV = "GRASPEXP_DATA"
 """Environment variable naming the data root when ``dataset.root`` is not set."""
@@ -288,12 +288,16 @@ def object_source(cfg: Any, name: str) -> ObjectSource:
         return folder.object_source(base, entries[name], str(cfg.units))
     path = mesh_path(cfg, name)
     if layout == "ycb":
+        google_16k = path.parent.name == "google_16k"
+        size = GOOGLE_16K_EXTENTS_MM.get(name) if google_16k else None
         return ObjectSource(
             name=name,
             parts=(MeshPart(path),),
             source=str(path.resolve()),
             mass_kg=YCB_MASS_KG[name],
-            published_faces=GOOGLE_16K_FACES if path.parent.name == "google_16k" else None,
+            published_faces=GOOGLE_16K_FACES if google_16k else None,
+            published_size=size,
+            published_where="the google_16k model's extents (graspexp.datasets.ycb_objects.GOOGLE_16K_EXTENTS_MM)",
         )
     models, ids = _bop_models(cfg)
     info = bop.read_models_info(models).get(ids[name]) if (models / bop.INFO_FILE).is_file() else None

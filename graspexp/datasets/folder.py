@@ -23,29 +23,34 @@ renders an object's area and writes a sidecar to start from.
 from __future__ import annotations
 
 import functools
+import logging
 import math
+import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 from scipy.spatial.transform import Rotation
 
 from graspexp.config import dataset
 from graspexp.config.constraints import Interval
+from graspexp.core.userinput import UserInputError, inside_folder, object_name_problem, read_user_yaml, shown
 from graspexp.datasets.errors import DatasetError, ObjectError
 from graspexp.datasets.regions import parse_entry
 from graspexp.datasets.source import MeshPart, ObjectSource
 
+log = logging.getLogger(__name__)
 MESH_SUFFIXES = (".obj", ".ply", ".stl", ".glb", ".gltf", ".off")
 """Mesh files of a folder dataset (case-insensitive)."""
 UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 """Unit names -> metres per file unit."""
+MASS_KG = Interval(0, 100, "right", "kg")
+"""An object's mass (a sidecar's ``mass_kg``, a URDF's ``<inertial>`` mass), kg: a graspable object."""
 SIDECAR_KEYS = ("units", "mass_kg", "density_kg_m3", "friction", "area", "note")
 SIDECAR_NUMBERS = {
-    "mass_kg": Interval(0, 100, "right", "kg"),
+    "mass_kg": MASS_KG,
     "density_kg_m3": dataset.CONSTRAINTS["density_kg_m3"][0],  # the bounds of dataset.density_kg_m3
     "friction": Interval(0, 5, "right"),
 }
@@ -75,13 +80,17 @@ def scan(folder: Path) -> dict[str, FolderEntry]:
 
 @functools.lru_cache(maxsize=8)
 def _scan_cached(folder: Path, _mtime_ns: int) -> dict[str, FolderEntry]:
-    files = sorted(p for p in folder.iterdir() if p.is_file())
+    files = sorted(p for p in folder.iterdir() if p.is_file() or p.is_symlink())  # a dangling link too
     urdfs = [p for p in files if p.suffix.lower() == ".urdf"]
     used = {f.resolve() for u in urdfs for f in _urdf_mesh_files(u)}
     found: dict[str, FolderEntry] = {}
+    invalid = []
     for path in files:
         is_urdf = path.suffix.lower() == ".urdf"
         if not is_urdf and (path.suffix.lower() not in MESH_SUFFIXES or path.resolve() in used):
+            continue
+        if object_name_problem(path.stem):
+            invalid.append(f"{path.name!r} ({object_name_problem(path.stem)})")
             continue
         if path.stem in found:
             raise DatasetError(
@@ -89,6 +98,8 @@ def _scan_cached(folder: Path, _mtime_ns: int) -> dict[str, FolderEntry]:
                 f"{path.name}; rename or move one of them"
             )
         found[path.stem] = FolderEntry(path.stem, path, is_urdf)
+    if invalid:  # its name would become a folder of the run: never written under
+        log.warning("folder %s: not an object, rename to use: %s", folder, "; ".join(invalid))
     if not found:
         raise DatasetError(
             f"folder dataset {folder} holds no mesh file ({', '.join(MESH_SUFFIXES)}) and no URDF; "
@@ -101,6 +112,10 @@ def object_source(folder: Path, entry: FolderEntry, default_units: str) -> Objec
     """The :class:`ObjectSource` of one folder object, its sidecar applied."""
     sidecar_path = folder / f"{entry.name}.yaml"
     side = read_sidecar(sidecar_path) if sidecar_path.is_file() else {}
+    if entry.file.is_symlink() and not entry.file.exists():
+        raise ObjectError(
+            f"mesh file {entry.file} is a symbolic link to {os.readlink(entry.file)}, which does not exist"
+        )
     notes: list[str] = []
     if entry.urdf:
         parts, urdf_mass = read_urdf(entry.file)
@@ -156,7 +171,7 @@ def units_factor(units: Any, what: str) -> float:
         factor = math.nan
     if not (math.isfinite(factor) and factor > 0):
         raise ObjectError(
-            f"{what}={units!r} is invalid: expected m, cm, mm or a positive number (metres per file unit)"
+            f"{what}={shown(units)} is invalid: expected m, cm, mm or a positive number (metres per file unit)"
         )
     return factor
 
@@ -165,20 +180,22 @@ def read_sidecar(path: Path) -> dict[str, Any]:
     """A sidecar's keys, checked strictly (types, ranges, no unknown or conflicting keys); raises
     :class:`ObjectError` naming the file and the key."""
     try:
-        data = yaml.safe_load(path.read_text())
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as err:
-        raise ObjectError(f"sidecar {path} cannot be read: {err}") from None
+        data = read_user_yaml(path, f"sidecar {path}")
+    except UserInputError as err:
+        raise ObjectError(str(err)) from None
     data = {} if data is None else data
     if not isinstance(data, dict):
         raise ObjectError(f"sidecar {path} must be a mapping of {', '.join(SIDECAR_KEYS)}")
-    unknown = sorted(set(map(str, data)) - set(SIDECAR_KEYS))
+    unknown = sorted(shown(k) for k in data if k not in SIDECAR_KEYS)
     if unknown:
-        raise ObjectError(f"sidecar {path}: unknown key(s) {unknown}; valid keys: {', '.join(SIDECAR_KEYS)}")
+        raise ObjectError(
+            f"sidecar {path}: unknown key(s) [{', '.join(unknown)}]; valid keys: {', '.join(SIDECAR_KEYS)}"
+        )
     if "mass_kg" in data and "density_kg_m3" in data:
         raise ObjectError(f"sidecar {path}: give mass_kg or density_kg_m3, not both")
     for key, allowed in SIDECAR_NUMBERS.items():
         if key in data and not allowed.accepts(data[key]):
-            raise ObjectError(f"sidecar {path}: {key}={data[key]!r} is invalid: expected {allowed}")
+            raise ObjectError(f"sidecar {path}: {key}={shown(data[key])} is invalid: expected {allowed}")
     if "units" in data:
         units_factor(data["units"], f"sidecar {path}: units")
     if "note" in data and not isinstance(data["note"], str):
@@ -216,6 +233,8 @@ def read_urdf(path: Path) -> tuple[tuple[MeshPart, ...], float | None]:
         raise ObjectError(f"URDF {path}: link {link.get('name')!r} has no <collision> geometry")
     mass_el = link.find("inertial/mass")
     mass = None if mass_el is None else _floats(mass_el, "value", 1, path)[0]
+    if mass is not None and not MASS_KG.accepts(mass):
+        raise ObjectError(f"URDF {path}: <inertial><mass value={mass:g}> is invalid: expected {MASS_KG}")
     return tuple(parts), mass
 
 
@@ -256,6 +275,11 @@ def _resolve(urdf: Path, filename: str) -> Path:
 
 def _mesh_file(urdf: Path, mesh: ET.Element) -> Path:
     file = _resolve(urdf, mesh.get("filename", ""))
+    if not inside_folder(file, urdf.parent):
+        raise ObjectError(
+            f"URDF {urdf}: mesh filename={shown(mesh.get('filename'))} leaves the URDF's folder; an object's "
+            "files are given relative to its folder, inside it"
+        )
     if not file.is_file():
         raise ObjectError(f"URDF {urdf}: mesh file {file} (filename={mesh.get('filename')!r}) not found")
     return file
@@ -270,7 +294,9 @@ def _floats(el: ET.Element, attr: str, n: int, path: Path, default: tuple | None
     except ValueError:
         values = ()
     if len(values) != n or not all(math.isfinite(v) and v > 0 for v in values):
-        raise ObjectError(f"URDF {path}: <{el.tag} {attr}={text!r}> must be {n} finite positive number(s)")
+        raise ObjectError(
+            f"URDF {path}: <{el.tag} {attr}={shown(text)}> must be {n} finite positive number(s)"
+        )
     return values
 
 

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 import trimesh
 
+from graspexp.config.dataset import DatasetConfig
 from graspexp.core.seeding import cloud_seed
 from graspexp.datasets.catalog import (
     available_objects,
@@ -23,10 +24,12 @@ from graspexp.datasets.catalog import (
 )
 from graspexp.datasets.errors import DatasetError, ObjectError
 from graspexp.datasets.meshcheck import (
+    check_face_count,
     check_file,
     check_geometry,
     check_published_faces,
     check_published_size,
+    declared_faces,
 )
 from graspexp.datasets.model import ObjectModel
 from graspexp.datasets.primitives import PRIMITIVES
@@ -164,17 +167,20 @@ def _object_mesh(cfg: Any, name: str) -> tuple[MeshEntry, ObjectSource]:
     if not source.parts:
         return _primitive_entry(name), source
     single = source.parts[0]
+    max_faces = int(getattr(cfg, "max_faces", DatasetConfig.max_faces))  # a plain object: the default
+    declared = [declared_faces(p.file) for p in source.parts if p.file is not None]
+    check_face_count(source.source, sum(n for n in declared if n is not None), max_faces)  # before reading
     if len(source.parts) == 1 and single.file is not None and single.origin is None:
         entry = load_mesh(single.file, single.scale)
     else:
         entry = _assembled(source)
+    check_face_count(source.source, len(entry.mesh.faces), max_faces)
     if source.published_faces is not None:
         check_published_faces(single.file, entry.file_faces, source.published_faces)
     if source.published_size is not None:
-        scale = np.asarray(single.scale, dtype=float)
         check_published_size(
             Path(source.source),
-            entry.mesh.extents / scale,
+            entry.mesh.extents * 1e3,  # m -> mm
             np.asarray(source.published_size),
             source.published_where,
         )

@@ -5,7 +5,9 @@
 - PLY: the header's ``element`` counts against the body, exactly (ASCII: one line per element; binary: the
   elements' bytes, list lengths read from the body).
 - YCB google_16k: every model has :data:`graspexp.datasets.ycb_objects.GOOGLE_16K_FACES` faces
-  (:func:`check_published_faces`), so a file cut together with its header is caught too.
+  (:func:`check_published_faces`), so a file cut together with its header is caught too; the staged
+  models' extents are carried (:data:`graspexp.datasets.ycb_objects.GOOGLE_16K_EXTENTS_MM`) and checked
+  like a BOP model's (:func:`check_published_size`): a file at another scale is refused.
 - BOP: ``models_info.json`` beside the models publishes each model's size; the loaded extents must match
   it (:func:`check_published_size`); LINEMOD models without an entry there are checked against the sizes
   the library carries (:data:`graspexp.datasets.bop.LM_SIZES_MM`).
@@ -28,7 +30,8 @@ from graspexp.datasets.errors import DatasetError, ObjectError
 MIN_EXTENT_M, MAX_EXTENT_M = 0.005, 1.0
 """A graspable object's largest extent lies in this range, m (outside: wrong units or a broken file)."""
 BOP_SIZE_TOLERANCE = 0.01
-"""Relative tolerance of a BOP model's extents against ``models_info.json`` (plus 0.5 mm)."""
+"""Relative tolerance of a model's extents against its published size (BOP ``models_info.json``, YCB
+google_16k: :data:`graspexp.datasets.ycb_objects.GOOGLE_16K_EXTENTS_MM`), plus 0.5 mm."""
 _OBJ_HEADER = re.compile(rb"^#\s*(vertices|faces)\s*:\s*(\d+)\s*$", re.IGNORECASE | re.MULTILINE)
 _PLY_SIZES = {"char": 1, "uchar": 1, "int8": 1, "uint8": 1, "short": 2, "ushort": 2, "int16": 2, "uint16": 2,
               "int": 4, "uint": 4, "int32": 4, "uint32": 4, "float": 4, "float32": 4, "double": 8, "float64": 8}  # fmt: skip
@@ -143,6 +146,35 @@ def check_file(path: Path) -> None:
         check_ply(path, data)
 
 
+def declared_faces(path: Path) -> int | None:
+    """The face count a mesh file declares or holds, read without parsing it (OBJ: its ``f`` lines; PLY: the
+    header's ``element face``; binary STL: its count field); None for other formats or an unreadable file."""
+    suffix = path.suffix.lower()
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read() if suffix == ".obj" else fh.read(1 << 16)
+    except OSError:
+        return None  # the loader names the problem
+    if suffix == ".obj":
+        return data.count(b"\nf ") + data.startswith(b"f ")
+    if suffix == ".ply":
+        words = data[: max(data.find(b"end_header"), 0)].decode("ascii", "replace").split()
+        counts = [words[i + 2] for i in range(len(words) - 2) if words[i : i + 2] == ["element", "face"]]
+        return int(counts[0]) if counts and counts[0].isdigit() else None
+    if suffix == ".stl" and data[:5].lower() != b"solid" and len(data) >= 84:
+        return int(np.frombuffer(data, "<u4", 1, 80)[0])
+    return None
+
+
+def check_face_count(what: str, n_faces: int, max_faces: int) -> None:
+    """Raise ObjectError if a mesh of ``n_faces`` exceeds the cap ``dataset.max_faces``."""
+    if n_faces > max_faces:
+        raise ObjectError(
+            f"mesh {what} has {n_faces:,} faces, more than dataset.max_faces={max_faces:,}: decimate it first "
+            "(e.g. MeshLab's Quadric Edge Collapse Decimation) or raise dataset.max_faces"
+        )
+
+
 def check_published_faces(path: Path, n_faces: int, expected: int) -> None:
     """Raise ObjectError unless the mesh file ``path``, read with ``n_faces`` faces, holds the face count its
     dataset publishes (a file cut together with its header declares nothing itself)."""
@@ -173,14 +205,12 @@ def check_geometry(what: str, extents_m: np.ndarray, units_hint: str = "") -> No
     )
 
 
-def check_published_size(
-    path: Path, extents_file_units: np.ndarray, published: np.ndarray, where: str
-) -> None:
-    """Compare a model's extents (file units) with the size its dataset publishes; ``where`` names the
-    publication (e.g. ``models_info.json``) in the message."""
-    if np.any(np.abs(extents_file_units - published) > 0.5 + BOP_SIZE_TOLERANCE * published):
+def check_published_size(path: Path, extents_mm: np.ndarray, published_mm: np.ndarray, where: str) -> None:
+    """Compare a model's extents (mm) with the size its dataset publishes (mm; within
+    :data:`BOP_SIZE_TOLERANCE` plus 0.5 mm); ``where`` names the publication in the message."""
+    if np.any(np.abs(extents_mm - published_mm) > 0.5 + BOP_SIZE_TOLERANCE * published_mm):
         raise _damaged(
             path,
-            f"its extents {np.round(extents_file_units, 2).tolist()} differ from the published size "
-            f"{np.round(published, 2).tolist()} in {where}",
+            f"its extents {np.round(extents_mm, 2).tolist()} mm differ from the published size "
+            f"{np.round(published_mm, 2).tolist()} mm in {where}",
         )

@@ -42,6 +42,14 @@ class ObjectModel:
         return digest.hexdigest()
 
     @cached_property
+    def area_sha256(self) -> str:
+        """SHA-256 of the grasping area the planner gets (the area mask over the seeded cloud, and the
+        cloud): an edited area spec hashes differently."""
+        digest = hashlib.sha256(np.packbits(np.asarray(self.area_mask, dtype=bool)).tobytes())
+        digest.update(np.ascontiguousarray(self.points, dtype=np.float64).tobytes())
+        return digest.hexdigest()
+
+    @cached_property
     def mesh_facts(self) -> dict[str, str]:
         """What the geometry is, readable: face count, surface area (m^2) and enclosed volume (m^3, "" if the
         mesh is not closed), as log metadata strings; a cut or rescaled file changes them."""

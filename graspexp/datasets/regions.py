@@ -45,10 +45,10 @@ from typing import Any
 
 import numpy as np
 import trimesh
-import yaml
 from sklearn.neighbors import KDTree
 
 from graspexp.config.constraints import Interval
+from graspexp.core.userinput import UserInputError, inside_folder, read_user_yaml, shown
 from graspexp.datasets.errors import DatasetError, ObjectError
 
 REGIONS_DIR = Path(__file__).parent / "regions"
@@ -147,10 +147,10 @@ def load_region_specs(path: Path | str) -> dict[str, RegionSpec]:
 @functools.lru_cache(maxsize=16)
 def _load_specs_cached(path: Path, _mtime_ns: int) -> dict[str, RegionSpec]:
     try:
-        data = yaml.safe_load(path.read_text()) or {}
-    except yaml.YAMLError as err:
-        raise DatasetError(f"grasping-area spec file {path} is not valid YAML: {err}") from None
-    if not isinstance(data, dict):
+        data = read_user_yaml(path, f"grasping-area spec file {path}") or {}
+    except UserInputError as err:
+        raise DatasetError(str(err)) from None
+    if not isinstance(data, dict) or not all(isinstance(name, str | int) for name in data):
         raise DatasetError(f"grasping-area spec file {path} must map object names to region specs")
     return {str(name): parse_entry(str(name), entry, path) for name, entry in data.items()}
 
@@ -162,10 +162,13 @@ def parse_entry(name: str, entry: Any, path: Path) -> RegionSpec:
     if isinstance(entry, list):
         entry = {"ops": entry}
     if not isinstance(entry, dict):
-        raise DatasetError(f"{where}: expected a mapping or a list of operations, got {entry!r}")
-    unknown = set(entry) - _ENTRY_KEYS
+        raise DatasetError(f"{where}: expected a mapping or a list of operations, got {shown(entry)}")
+    unknown = sorted(shown(k) for k in entry if k not in _ENTRY_KEYS)
     if unknown:
-        raise DatasetError(f"{where}: unknown keys {sorted(unknown)}; valid keys: {sorted(_ENTRY_KEYS)}")
+        raise DatasetError(f"{where}: unknown keys [{', '.join(unknown)}]; valid keys: {sorted(_ENTRY_KEYS)}")
+    for key in ("note", "meshlab_ply"):
+        if entry.get(key) is not None and not isinstance(entry[key], str):
+            raise DatasetError(f"{where}: {key} must be text, got {type(entry[key]).__name__}")
     relative = _flag(entry.get("relative", False), f"{where}: relative")
     raw_ops = entry.get("ops") or []
     if not isinstance(raw_ops, list):
@@ -182,33 +185,37 @@ def parse_entry(name: str, entry: Any, path: Path) -> RegionSpec:
         tolerance_m=None
         if entry.get("tolerance_m") is None
         else _positive(entry["tolerance_m"], f"{where}: tolerance_m"),
-        note=str(entry.get("note", "")),
+        note=entry.get("note") or "",
     )
 
 
 def _parse_op(op: Any, relative: bool, where: str) -> RegionOp:
     if not isinstance(op, dict) or len(op) != 1:
         raise DatasetError(
-            f"{where}: an operation is a one-key mapping such as {{keep_box: {{...}}}}, got {op!r}"
+            f"{where}: an operation is a one-key mapping such as {{keep_box: {{...}}}}, got {shown(op)}"
         )
     ((kind, params),) = op.items()
     if kind not in _OP_NAMES:
-        raise DatasetError(f"{where}: unknown operation {kind!r}; valid: {', '.join(sorted(_OP_NAMES))}")
+        raise DatasetError(f"{where}: unknown operation {shown(kind)}; valid: {', '.join(sorted(_OP_NAMES))}")
     mode, shape = kind.split("_", 1)
     if params is None or params is True:
         params = {}
     if not isinstance(params, dict):
-        raise DatasetError(f"{where}: parameters of {kind} must be a mapping, got {params!r}")
+        raise DatasetError(f"{where}: parameters of {kind} must be a mapping, got {shown(params)}")
     params = dict(params)
     op_relative = _flag(params.pop("relative", relative), f"{where}: {kind}.relative")
     expected = _SHAPE_PARAMS.get(shape, ())
     if set(params) != set(expected):
-        raise DatasetError(f"{where}: {kind} takes exactly {list(expected)}, got {sorted(params)}")
+        raise DatasetError(
+            f"{where}: {kind} takes exactly {list(expected)}, got [{', '.join(sorted(map(shown, params)))}]"
+        )
     for key, value in params.items():
         size = 1 if key in ("offset", "radius") else 3
         array = np.asarray(value, dtype=float) if _is_numeric(value) else None
         if array is None or array.size != size or not np.all(np.isfinite(array)):
-            raise DatasetError(f"{where}: {kind}.{key} must be {size} finite number(s), got {value!r}")
+            raise DatasetError(f"{where}: {kind}.{key} must be {size} finite number(s), got {shown(value)}")
+    if shape == "halfspace" and not np.linalg.norm(np.asarray(params["normal"], float)) > 0:
+        raise DatasetError(f"{where}: {kind}.normal must not be zero (it would select every point)")
     if shape == "box" and np.any(np.asarray(params["min"], float) > np.asarray(params["max"], float)):
         raise DatasetError(f"{where}: {kind} has min > max: {params['min']} vs {params['max']}")
     if shape == "cylinder" and np.allclose(params["p0"], params["p1"]):
@@ -221,14 +228,14 @@ def _parse_op(op: Any, relative: bool, where: str) -> RegionOp:
 def _flag(value: Any, what: str) -> bool:
     """``value`` if it is a YAML boolean (``true``/``false``), else a DatasetError: ``"false"`` is not false."""
     if not isinstance(value, bool):
-        raise DatasetError(f"{what} must be true or false (unquoted), got {value!r}")
+        raise DatasetError(f"{what} must be true or false (unquoted), got {shown(value)}")
     return value
 
 
 def _positive(value: Any, what: str) -> float:
     """``value`` as a float if it is a finite positive number, else a DatasetError naming ``what``."""
     if not POSITIVE.accepts(value):
-        raise DatasetError(f"{what} must be a positive number, got {value!r}")
+        raise DatasetError(f"{what} must be a positive number, got {shown(value)}")
     return float(value)
 
 
@@ -273,10 +280,12 @@ def import_meshlab_area(
     try:
         loaded = trimesh.load(path, process=False)
     except Exception as err:  # trimesh raises many types for unreadable files
-        raise DatasetError(f"cannot read MeshLab area file {path}: {err}") from None
+        raise ObjectError(
+            f"cannot read MeshLab area file {path}: {type(err).__name__}: {shown(str(err))}"
+        ) from None
     area = np.asarray(getattr(loaded, "vertices", np.empty((0, 3))), dtype=float) * float(scale)
-    if len(area) < 2 or not np.all(np.isfinite(area)):
-        raise DatasetError(f"MeshLab area file {path} needs at least 2 finite points, has {len(area)}")
+    if area.ndim != 2 or area.shape[1:] != (3,) or len(area) < 2 or not np.all(np.isfinite(area)):
+        raise ObjectError(f"MeshLab area file {path} needs at least 2 finite points (3-D), has {len(area)}")
     tree = KDTree(area)
     if tolerance_m is None:
         spacing, _ = tree.query(area, k=2)
@@ -308,12 +317,20 @@ def area_mask(
 
 
 def _find_meshlab_file(spec: RegionSpec, data_dirs: Sequence[Path]) -> Path:
-    given = Path(str(spec.meshlab_ply)).expanduser()
-    candidates = [given] if given.is_absolute() else [d / given for d in (spec.spec_file.parent, *data_dirs)]
+    """The file ``meshlab_ply`` names: relative to the spec file's folder or one of ``data_dirs``, inside
+    that folder (an object's files never reach outside the folders it is read from)."""
+    given = Path(str(spec.meshlab_ply))
+    folders = (spec.spec_file.parent, *data_dirs)
+    candidates = [d / given for d in folders if inside_folder(d / given, d)]
+    if given.is_absolute() or str(given).startswith("~") or not candidates:
+        raise ObjectError(
+            f"meshlab_ply={shown(spec.meshlab_ply)} of object {spec.name!r} in {spec.spec_file} leaves its "
+            "folder: give a path relative to that folder, inside it"
+        )
     for candidate in candidates:
         if candidate.is_file():
             return candidate
-    raise DatasetError(
+    raise ObjectError(
         f"MeshLab area file for object {spec.name!r} (meshlab_ply in {spec.spec_file}) not found: "
         + " or ".join(str(c.resolve()) for c in candidates)
     )

@@ -42,7 +42,8 @@ class ObjectSource:
     friction: float | None = None
     """A sidecar's Coulomb friction of the object (static and dynamic); None: ``sim.object_*_friction``."""
     published_size: tuple[float, float, float] | None = None
-    """Extents the dataset publishes (BOP ``models_info.json``), file units; the loaded mesh must match."""
+    """Extents the dataset publishes (BOP ``models_info.json``, YCB's google_16k models), mm; the loaded mesh
+    must match."""
     published_faces: int | None = None
     """Face count the dataset publishes for this file (YCB google_16k); the file must hold exactly that many."""
     published_where: str = "models_info.json"

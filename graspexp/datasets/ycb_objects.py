@@ -94,3 +94,36 @@ YCB_MASS_KG: dict[str, float] = {
 GOOGLE_16K_FACES = 16384
 """Faces of every google_16k model: Google's scans decimated to 16k (2^14) triangles (each file's own
 ``# Faces:`` header says so where it has one). A google_16k file holding another count is cut or damaged."""
+
+GOOGLE_16K_EXTENTS_MM: dict[str, tuple[float, float, float]] = {
+    "002_master_chef_can": (102.5, 102.4, 140.2),  # textured.obj sha256 2d179b0ae197312e
+    "003_cracker_box": (71.8, 164.0, 213.4),  # textured.obj sha256 387d3c0e36330051
+    "004_sugar_box": (49.5, 94.2, 176.0),  # textured.obj sha256 b7333f94bf81703e
+    "005_tomato_soup_can": (67.9, 67.7, 101.9),  # textured.obj sha256 0da7d8ca01caefa1
+    "006_mustard_bottle": (97.2, 66.6, 191.3),  # textured.obj sha256 aa81d47a5c37431c
+    "007_tuna_fish_can": (85.6, 85.5, 33.5),  # textured.obj sha256 b1c1e69b902d29b7
+    "008_pudding_box": (137.9, 128.8, 38.9),  # textured.obj sha256 8e72a0e501429e17
+    "009_gelatin_box": (89.4, 101.1, 30.1),  # textured.obj sha256 85ed671e61720e72
+    "010_potted_meat_can": (102.1, 60.1, 83.5),  # textured.obj sha256 07c0d2c0dcc12c5e
+    "011_banana": (108.9, 178.4, 36.7),  # textured.obj sha256 6f9bc2218bf6ff48
+    "019_pitcher_base": (149.1, 144.8, 242.4),  # textured.obj sha256 0642b636f2e7e80d
+    "021_bleach_cleanser": (102.4, 67.7, 250.6),  # textured.obj sha256 79c290ba3a530670
+    "024_bowl": (161.5, 161.2, 55.0),  # textured.obj sha256 0f134a66c903353a
+    "025_mug": (117.0, 93.1, 81.3),  # textured.obj sha256 2d40b407e9e97402
+    "035_power_drill": (184.2, 187.5, 57.3),  # textured.obj sha256 35d0cc4e55366c36
+    "036_wood_block": (90.6, 89.9, 206.0),  # textured.obj sha256 ed74484d3c991d3c
+    "037_scissors": (96.1, 201.5, 15.7),  # textured.obj sha256 57e86a1f6424b29a
+    "040_large_marker": (21.0, 121.0, 18.9),  # textured.obj sha256 7297294d2f21a60b
+    "043_phillips_screwdriver": (194.9, 107.0, 35.5),  # textured.obj sha256 9cb844f685fe9101
+    "044_flat_screwdriver": (161.9, 156.9, 35.0),  # textured.obj sha256 fb7c48e65cad5c8d
+    "051_large_clamp": (120.0, 171.1, 39.2),  # textured.obj sha256 114e4394390e0faa
+    "052_extra_large_clamp": (210.0, 164.3, 36.3),  # textured.obj sha256 c2274b0a1053bab2
+    "061_foam_brick": (52.6, 77.9, 51.2),  # textured.obj sha256 04a5b79997a87463
+}
+"""Object id -> the axis-aligned extents (x, y, z) of its google_16k model in its own frame, mm (one decimal).
+Source: measured once from the google_16k ``textured.obj`` files as published on ycbbenchmarks.com
+(through elpis-lab/ycb_dataset de71485; each file's SHA-256 prefix beside it), the 23 objects staged for
+this project; the model is the publication, so its size is the published size. A google_16k file at
+another scale (a 0.58 m mug, a 1.8 cm banana) is refused like a BOP model against ``models_info.json``.
+The other ids are not checked for size (only :data:`graspexp.datasets.meshcheck.MIN_EXTENT_M` ...
+``MAX_EXTENT_M``)."""

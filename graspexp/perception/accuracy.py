@@ -8,13 +8,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from graspexp.config.perception import PerceptionConfig
-from graspexp.core.geometry import make_pose, random_rotation
+from graspexp.core.geometry import make_pose, pose_error, random_rotation
 from graspexp.core.seeding import rng_for
 from graspexp.datasets.model import ObjectModel
 from graspexp.perception.camera import BoxBody, MeshBody
 from graspexp.perception.observe import estimate_pose, observe
 from graspexp.perception.registration import pose_errors
-from graspexp.planning.stability import pose_error
 
 SUPPORT_HALF_M = 0.15
 """Half size of the support box the bench places the object on (the collab box), m."""

@@ -4,9 +4,13 @@ estimator's output refined, as PVN3D's pose is), or, without a prior, global reg
 trial records: translation (mm), rotation (deg) and ADD-S (Hinterstoisser et al. 2012's symmetric
 average distance, mm).
 
-Open3D is imported when a registration runs (the ``camera`` extra).
+Open3D is imported when a registration runs (the ``camera`` extra), its parallel loops limited to one
+thread (``open3d.utility.set_max_threads(1)``): with two, ICP's parallel sums land in a varying order and
+the registered pose changed in its last digits from run to run (measured: 3 different poses in 15
+identical registrations), against the project's same-config-same-result rule.
 """
 
+import functools
 import time
 from dataclasses import dataclass
 
@@ -34,12 +38,15 @@ class Registration:
     wall_s: float
 
 
+@functools.cache
 def open3d():
-    """The ``open3d`` module; ImportError naming the install command when it is absent."""
+    """The ``open3d`` module, its parallel loops limited to one thread (module doc); ImportError naming the
+    install command when it is absent."""
     try:
         import open3d as o3d
     except ImportError:
         raise ImportError(f"pose registration needs open3d-cpu, not installed: {CAMERA_EXTRA}") from None
+    o3d.utility.set_max_threads(1)
     return o3d
 
 

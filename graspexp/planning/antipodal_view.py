@@ -28,7 +28,7 @@ Steps (world frame, metres; the target's observed points and their normals, orie
 
 import numpy as np
 
-from graspexp.config.gripper import GripperGeometry
+from graspexp.grippers import GripperGeometry
 from graspexp.planning.antipodal import approaches_about, tilt_deg
 from graspexp.planning.collision import frame_from_axes, max_lift_m, place_grasps
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp

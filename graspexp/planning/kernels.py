@@ -5,7 +5,8 @@ Each kernel is a plain serial loop (no threads: on a shared 2-core machine ``pra
 numba compiles on first use and caches on disk, so a process pays the compilation once per machine and
 afterwards only numba's import and the cache load (docs/guide/development.md). The cache lives in
 ``$NUMBA_CACHE_DIR`` when set, else in a per-user folder (:func:`numba_cache_dir`, mode 0700), never in the
-shared ``$GRASPEXP_CACHE`` nor beside the installed package. When no private writable folder is found the
+shared ``$GRASPEXP_CACHE`` nor beside the installed package; either must be private (owned by this user,
+writable by no one else: numba's index files are pickles). When no private writable folder is found the
 kernels still work, compiled afresh in every process.
 
 The public wrappers live with their meaning: :func:`graspexp.planning.cost.all_path_costs` and
@@ -41,16 +42,17 @@ def numba_cache_dir() -> Path:
     return Path(base) / "graspexp" / "numba"
 
 
-def _private(folder: Path) -> bool:
+def _private(folder: Path, what: str) -> bool:
     """True when ``folder`` exists (created ``0700`` here if needed), is owned by this user and writable by
-    no one else, and a file can be written in it."""
+    no one else, and a file can be written in it; ``what`` names where the folder came from."""
     try:
         folder.mkdir(mode=0o700, parents=True, exist_ok=True)
         st = folder.stat()
         if st.st_uid != os.getuid() or st.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
             warnings.warn(
-                f"numba cache {folder} is not private to this user (owner or group/other write access); "
-                "compiling the planner's kernels in this process instead (chmod 700 it, or set NUMBA_CACHE_DIR)",
+                f"numba cache {folder} ({what}) is not private to this user (another owner, or group/other "
+                "write access: its pickles would run anyone's code); compiling the planner's kernels in this "
+                "process instead: point it at a folder of your own, mode 700",
                 RuntimeWarning,
                 stacklevel=2,
             )
@@ -63,11 +65,11 @@ def _private(folder: Path) -> bool:
 
 def _enable_disk_cache() -> bool:
     """Point numba's cache at the per-user folder (module doc); False when it is not usable. A
-    ``$NUMBA_CACHE_DIR`` set by the user wins and is used as given."""
+    ``$NUMBA_CACHE_DIR`` set by the user wins if it is private too (else the kernels are not cached)."""
     if numba.config.CACHE_DIR:
-        return True
+        return _private(Path(numba.config.CACHE_DIR), "NUMBA_CACHE_DIR")
     numba.config.CACHE_DIR = str(numba_cache_dir())
-    return _private(Path(numba.config.CACHE_DIR))
+    return _private(Path(numba.config.CACHE_DIR), "the per-user default")
 
 
 _CACHE = _enable_disk_cache()

@@ -29,7 +29,7 @@ axis, origin midway between the pads; the fingers span ``[root_z_m, tip_z_m]`` a
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
-from graspexp.core.geometry import axis_angle_matrix
+from graspexp.core.geometry import pose_error
 from graspexp.grippers import GripperGeometry
 from graspexp.planning.kernels import pad_contact_stats, pad_edge_excess
 
@@ -118,14 +118,6 @@ def pad_edge_excess_m(
         geometry.finger_thickness_m,
         clearance_m,
     )
-
-
-def pose_error(rng: np.random.Generator, trans_mm: float, rot_deg: float) -> tuple[np.ndarray, np.ndarray]:
-    """One draw of the pose estimator's error: (3, 3) rotation about a random axis by a Gaussian angle
-    (std ``rot_deg``) and (3,) Gaussian translation (std ``trans_mm`` per axis), m. The one error model of
-    the simulated perception (:func:`graspexp.sim.perceive.perceived_pose`) and of the planner's noise check."""
-    rotation = axis_angle_matrix(rng.normal(size=3), np.deg2rad(rng.normal(0.0, rot_deg)))
-    return rotation, rng.normal(0.0, trans_mm, size=3) / 1000.0
 
 
 def pose_perturbations(

@@ -10,6 +10,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import trimesh
 from foxglove.messages import (
     Color,
     CubePrimitive,
@@ -29,6 +30,9 @@ from graspexp.sim.collision_shapes import hull_meshes
 
 SCENE_DECIMALS = 6
 """Mesh vertices are rounded to this many decimals of a metre (1 um)."""
+LOG_MESH_MAX_FACES = 20_000
+"""A URDF gripper link is drawn into each trial's log with at most this many triangles (decimated, quadric
+error): the log draws the shape, the physics uses its hulls; a 2.6M-face scan would add 36 MB to every log."""
 SUPPORT_COLOR = (0.6, 0.45, 0.3, 1.0)
 HULL_COLOR = (0.2, 0.4, 0.9, 1.0)
 GRIPPER_COLOR = (0.5, 0.5, 0.5, 1.0)
@@ -144,5 +148,9 @@ def hand_entities(hand: HandMeshes) -> list[SceneEntity]:
         starts = np.cumsum([0] + [len(v) for v, _ in meshes[:-1]])
         vertices = np.concatenate([v for v, _ in meshes])
         faces = np.concatenate([f + s for (_, f), s in zip(meshes, starts, strict=True)])
+        if len(faces) > LOG_MESH_MAX_FACES:
+            drawn = trimesh.Trimesh(vertices, faces, process=False)
+            drawn = drawn.simplify_quadric_decimation(face_count=LOG_MESH_MAX_FACES)
+            vertices, faces = np.asarray(drawn.vertices), np.asarray(drawn.faces)
         out.append(mesh_entity(name, name, vertices, faces, GRIPPER_COLOR))
     return out

@@ -416,8 +416,10 @@ class TrialRecorder(TrialWriter):
         self.path = Path(path)
         self.partial_path = self.path.with_name(self.path.name + PARTIAL_SUFFIX)
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self.path.unlink(missing_ok=True)
-        self._file = open(self.partial_path, "wb")  # closed by close() or abort()
+        self.path.unlink(missing_ok=True)  # a link there is removed, never written through
+        self.partial_path.unlink(missing_ok=True)
+        flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW  # a link planted meanwhile: refused
+        self._file = os.fdopen(os.open(self.partial_path, flags, 0o644), "wb")  # closed by close() or abort()
         try:
             super().__init__(self._file, metadata, channels)
         except BaseException:

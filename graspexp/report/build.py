@@ -62,7 +62,8 @@ def build_report(root: Path | str, progress: bool = True) -> Report:
     df[IN_AREA_COLUMN] = held_in_area(df, progress)
     tables = success_tables(df)
     agreements = [a for a in map(agreement, tables) if a is not None]
-    return Report(col, tables, failure_breakdown(df), runtime_table(df), strict_table(df), agreements)
+    outcomes = pd.concat([df, col.not_run], ignore_index=True)  # counts: the not-run trials as `error`
+    return Report(col, tables, failure_breakdown(outcomes), runtime_table(df), strict_table(df), agreements)
 
 
 def _runtime_display(rt: pd.DataFrame) -> pd.DataFrame:
@@ -93,6 +94,23 @@ def _unreadable_section(col: Collected) -> list[str]:
     )
     lines.append("")
     lines += [f"- `{p}`: {reason}" for p, reason in col.unreadable]
+    return [*lines, ""]
+
+
+def _not_run_section(col: Collected) -> list[str]:
+    """The trials that ended in ``error``, per object and setting: not run, so in no table or average."""
+    if col.not_run.empty:
+        return []
+    lines = [
+        f"## Not run ({len(col.not_run)} trials)",
+        "",
+        "These trials ended in an error (an object that could not be used, a trial that raised); they are "
+        "in no success rate, average or paper comparison above (an object without a run trial shows n/a).",
+        "",
+    ]
+    for key, group in col.not_run.groupby(["dataset", "planner", "mode", "rot", "object"], sort=False):
+        why = str(group["error"].iloc[0]).splitlines()[0] if "error" in group else ""
+        lines.append(f"- {'/'.join(key[:4])} {key[4]!r}: {len(group)} trial(s) not run: {why}")
     return [*lines, ""]
 
 
@@ -164,7 +182,8 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
     md = [
         f"# graspexp report: {col.root}",
         "",
-        f"{n_logs} trial logs found, {len(col.results)} results read.",
+        f"{n_logs + len(col.not_run)} trial logs found, {len(col.results)} results read"
+        + (f", {len(col.not_run)} trials not run (listed below)." if len(col.not_run) else "."),
         "",
     ]
     for table in report.tables:
@@ -250,6 +269,7 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
             "reason, drawn from their logs at the close and at the end (`gallery/*.png`).",
             "",
         ]
+    md += _not_run_section(col)
     md += _unreadable_section(col)
     if col.unreadable:
         pd.DataFrame(col.unreadable, columns=["path", "reason"]).to_csv(out / "unreadable.csv", index=False)

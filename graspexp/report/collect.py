@@ -10,15 +10,17 @@ reason, for the tools to name. The report, the planner comparison, the benchmark
 read their results here.
 """
 
+import math
+import typing
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
-import yaml
 
 from graspexp.config.differences import result_config
-from graspexp.core.outcome import result_from_dict
+from graspexp.core.outcome import FailureReason, TrialResult, result_from_dict
 from graspexp.core.run_layout import TRIALS_DIR, hydra_dir, results_tables, trials_dir
+from graspexp.core.userinput import load_user_yaml, read_user_yaml, shown
 from graspexp.record import CorruptLogError, read_result
 from graspexp.record.reader import read_metadata
 from graspexp.record.writer import PARTIAL_SUFFIX
@@ -40,6 +42,11 @@ FINGERPRINT_KEYS = (
 )
 CONFIG_COLUMN = "_config"
 """Working column of :func:`collect`: each log's result-affecting config, flattened (dropped before return)."""
+SHAPES_COLUMN = "_shapes"
+"""Working column of :func:`collect`: what each log recorded of its object's geometry (:data:`SHAPE_KEYS`)."""
+SHAPE_KEYS = ("collision_key", "collision_sha256", "area_sha256")
+"""Log metadata naming the collision shape a trial used (its cache key, from the mesh and the method's
+parameters, and the SHA-256 of the shape itself) and its grasping area (the SHA-256 of the area mask)."""
 """The runner's per-run cache of its trials' results."""
 
 
@@ -55,6 +62,10 @@ class Collected:
     """(path, reason) for each log that could not be read."""
     duplicates: list[tuple[Path, Path]] = field(default_factory=list)
     """(ignored log, kept log) for trials logged twice below the root (same TRIAL_KEYS)."""
+    not_run: pd.DataFrame = field(default_factory=pd.DataFrame)
+    """The trials that ended in ``error`` (an object that could not be used, a trial that raised), in
+    :attr:`results`' columns: not run to an outcome, so never scored (no success rate, average, paper
+    table or objective counts them); the report lists them as not run."""
 
 
 def find_trial_logs(root: Path | str) -> list[Path]:
@@ -93,34 +104,85 @@ def _log_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
             config_yaml = meta.get("config_yaml")
             if config_yaml is None:
                 raise CorruptLogError(f"{path}: not a graspexp trial log (no graspexp metadata)")
-            config = yaml.safe_load(config_yaml)
+            config = load_user_yaml(config_yaml, f"{path}: its recorded config")
             if not isinstance(config, dict):
                 raise CorruptLogError(f"{path}: its recorded config is not a job config")
             result_from_dict(result)
-        except (CorruptLogError, OSError, yaml.YAMLError, ValueError) as exc:
+        except (CorruptLogError, OSError, ValueError) as exc:
             unreadable.append((path, str(exc) if str(path) in str(exc) else f"{path}: {exc}"))
             continue
         row = _row(result, path, noise_of(config))
         row[CONFIG_COLUMN] = result_config(config)
+        row[SHAPES_COLUMN] = {k: meta[k] for k in SHAPE_KEYS if k in meta}
         row[FINGERPRINT_COLUMN] = fingerprint(meta)
         rows.append(row)
     return rows, unreadable
 
 
-def _csv_rows(root: Path) -> list[dict]:
-    """Rows of every results.csv below ``root`` whose run directory holds no trial log."""
-    rows = []
+def _csv_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
+    """Rows of every results.csv below ``root`` whose run directory holds no trial log, each checked as
+    strictly as a log's /result (:func:`csv_result`); a table with a bad row is unreadable as a whole."""
+    rows, unreadable = [], []
     for table in results_tables(root):
         run_dir = table.parent
         if trials_dir(run_dir).is_dir() and find_trial_logs(run_dir):
             continue
         hydra_cfg = hydra_dir(run_dir) / "config.yaml"
-        noise = noise_of(yaml.safe_load(hydra_cfg.read_text())) if hydra_cfg.is_file() else (0.0, 0.0)
-        for result in pd.read_csv(table).to_dict("records"):
-            timings = result.get("timings_s")
-            result["timings_s"] = yaml.safe_load(timings) if isinstance(timings, str) else None
-            rows.append(_row(result, "", noise))
-    return rows
+        try:
+            config = read_user_yaml(hydra_cfg) if hydra_cfg.is_file() else None
+            noise = noise_of(config if isinstance(config, dict) else None)
+            records = pd.read_csv(table, dtype=str, keep_default_na=False).to_dict("records")
+            results = [csv_result(r, f"{table} row {i + 2}") for i, r in enumerate(records)]
+        except (OSError, UnicodeDecodeError, ValueError, pd.errors.ParserError) as exc:
+            unreadable.append((table, str(exc) if str(table) in str(exc) else f"{table}: {exc}"))
+            continue
+        rows += [_row(result, "", noise) for result in results]
+    return rows, unreadable
+
+
+def csv_result(record: dict[str, str], where: str) -> dict:
+    """One results.csv row (every value the text pandas wrote) as a /result dict, each field converted by
+    its type in :class:`TrialResult` (``True``/``False``, integers within 64 bits, numbers, flow-style
+    lists and mappings; empty: None) and then checked by :func:`result_from_dict`. ValueError names
+    ``where`` and the field."""
+    hints = typing.get_type_hints(TrialResult)
+    out: dict = {}
+    for key, text in record.items():
+        if key not in hints:
+            continue
+        tp = hints[key]
+        try:
+            out[key] = _csv_value(text, tp)
+        except ValueError:
+            raise ValueError(f"{where}: {key}={shown(text)} is not {tp}") from None
+    try:
+        result_from_dict(out)
+    except ValueError as exc:
+        raise ValueError(f"{where}: {exc}") from None
+    return out
+
+
+def _csv_value(text: str, tp: object) -> object:
+    optional = type(None) in typing.get_args(tp)  # ``X | None``: empty text is None
+    if optional and text == "":
+        return None
+    base = next(a for a in typing.get_args(tp) if a is not type(None)) if optional else tp
+    if base is bool:
+        if text not in ("True", "False"):
+            raise ValueError(text)
+        return text == "True"
+    if base is int:
+        value = int(text) if len(text) <= 20 else None
+        if value is None or not -(2**63) <= value < 2**63:
+            raise ValueError(text)
+        return value
+    if base is float:  # pandas writes NaN as empty text
+        if len(text) > 40:
+            raise ValueError(text)
+        return float(text) if text else math.nan
+    if base is str:
+        return text
+    return load_user_yaml(text, "a results.csv field")  # lists and mappings, in flow style
 
 
 def collect(root: Path | str) -> Collected:
@@ -128,12 +190,17 @@ def collect(root: Path | str) -> Collected:
     where a run has none (module doc)."""
     root = Path(root)
     rows, unreadable = _log_rows(root)
-    rows += _csv_rows(root)
+    csv_rows, bad_tables = _csv_rows(root)
+    rows += csv_rows
+    unreadable += bad_tables
     df = pd.DataFrame(rows)
     duplicates: list[tuple[Path, Path]] = []
+    not_run = pd.DataFrame()
     if not df.empty:
-        df["success"] = df["success"].astype(str).str.lower().isin(("true", "1", "1.0"))  # csv rows: text
         df["trial"] = df["trial"].astype(int)
+        if "at_rest" in df:  # logs from before not_at_rest existed planned on the moving object
+            moving = df["at_rest"].eq(False) & df["reason"].ne(FailureReason.ERROR.value)
+            df.loc[moving, ["success", "reason"]] = [False, FailureReason.NOT_AT_REST.value]
         dup = df.duplicated(list(TRIAL_KEYS), keep="first")
         if dup.any():
             first = df[~dup].set_index(list(TRIAL_KEYS))["path"]
@@ -141,8 +208,18 @@ def collect(root: Path | str) -> Collected:
                 duplicates.append((Path(r["path"]), Path(first.loc[tuple(r[k] for k in TRIAL_KEYS)])))
             df = df[~dup].reset_index(drop=True)
         check_one_config_per_cell(df)
-        df = df.drop(columns=CONFIG_COLUMN, errors="ignore")
-    return Collected(root=root, results=df, unreadable=unreadable, duplicates=duplicates)
+        check_one_shape_per_object(df)
+        df = df.drop(columns=[CONFIG_COLUMN, SHAPES_COLUMN], errors="ignore")
+        scored = ran(df)
+        not_run, df = df.drop(scored.index).reset_index(drop=True), scored.reset_index(drop=True)
+    return Collected(root=root, results=df, unreadable=unreadable, duplicates=duplicates, not_run=not_run)
+
+
+def ran(df: pd.DataFrame) -> pd.DataFrame:
+    """The trials of a results table that ran to an outcome: all but those that ended in ``error`` (an
+    object that could not be used, a trial that raised), which are never scored (no rate, average, paper
+    table or objective counts them)."""
+    return df[df["reason"] != FailureReason.ERROR.value]
 
 
 def fingerprint(meta: dict[str, str]) -> str:
@@ -153,6 +230,41 @@ def fingerprint(meta: dict[str, str]) -> str:
         return "unrecorded"
     cpu, flags, sapien, numpy, graspexp = (v or "?" for v in values)
     return f"{cpu} (flags {flags}), sapien {sapien}, numpy {numpy}, graspexp {graspexp}"
+
+
+def check_one_shape_per_object(df: pd.DataFrame) -> None:
+    """Raise :class:`MixedConfigError` if two logs built from one cache key (same mesh, method, parameters
+    and libraries) used different collision shapes (a cache entry rewritten between them: one of them was
+    not what graspexp builds), or if trials of one object in one table cell used different grasping areas
+    (an area spec edited between runs). Logs that record neither are not compared."""
+    if SHAPES_COLUMN not in df:
+        return
+    logged = df[df[SHAPES_COLUMN].notna()]
+    keys = pd.DataFrame(list(logged[SHAPES_COLUMN]), index=logged.index, columns=list(SHAPE_KEYS))
+    checks = (
+        (
+            "collision_sha256",
+            ["collision_key"],
+            "collision shapes from one cache key (a rewritten cache entry?)",
+        ),
+        (
+            "area_sha256",
+            [*SETTING_KEYS, *NOISE_KEYS, "object"],
+            "grasping areas (an area spec edited between runs?)",
+        ),
+    )
+    for column, group_by, what in checks:
+        table = pd.concat([logged[["object", "path", *SETTING_KEYS, *NOISE_KEYS]], keys], axis=1)
+        table = table[table[column].notna() & table[group_by].notna().all(axis=1)]
+        for _, group in table.groupby(group_by, sort=False):
+            values = group.drop_duplicates(column)
+            if len(values) > 1:
+                a, b = values.iloc[0], values.iloc[1]
+                raise MixedConfigError(
+                    f"trials of {a['object']} used two {what}: {column} {a[column][:12]} in {a['path']}, "
+                    f"{b[column][:12]} in {b['path']}; a table never merges them: rerun one of them into a new "
+                    "directory with a private cache (GRASPEXP_CACHE)"
+                )
 
 
 class MixedConfigError(ValueError):

@@ -77,10 +77,27 @@ def sqlite_path(storage: str) -> Path | None:
     return Path(storage[len(prefix) :]) if storage.startswith(prefix) else None
 
 
-def write_study_record(sweep_dir: Path, storage: str, study_name: str, task_overrides: list[str]) -> None:
-    """Write :data:`STUDY_YAML` into ``sweep_dir``: where the study is stored and the command's overrides."""
-    record = {"storage": storage, "study_name": study_name, "task_overrides": task_overrides}
+def write_study_record(
+    sweep_dir: Path, storage: str, study_name: str, task_overrides: list[str], inputs: dict[str, str]
+) -> None:
+    """Write :data:`STUDY_YAML` into ``sweep_dir``: where the study is stored, the command's overrides and
+    the inputs its trials read (data root, mesh SHA-256s: :func:`graspexp.run.study.study_inputs`)."""
+    record = {
+        "storage": storage,
+        "study_name": study_name,
+        "task_overrides": task_overrides,
+        "inputs": inputs,
+    }
     OmegaConf.save(OmegaConf.create(record), sweep_dir / STUDY_YAML)
+
+
+def recorded_inputs(sweep_dir: Path) -> dict[str, str]:
+    """The inputs recorded with the study in ``sweep_dir`` ({} for none, or a study recorded before them)."""
+    path = sweep_dir / STUDY_YAML
+    if not path.is_file():
+        return {}
+    inputs = OmegaConf.load(path).get("inputs")
+    return {str(k): str(v) for k, v in inputs.items()} if inputs else {}
 
 
 def recorded_overrides(sweep_dir: Path) -> list[str] | None:

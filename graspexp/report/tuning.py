@@ -18,6 +18,7 @@ import pandas as pd
 from scipy.stats import binomtest
 
 from graspexp.config.job import JobConfig
+from graspexp.report.collect import ran
 from graspexp.report.stats import success_pct
 from graspexp.report.study import SweepStudy, is_log_scale
 
@@ -48,6 +49,10 @@ OBJECTIVE_WORDS = {
 
 
 def _rate(df: pd.DataFrame) -> str:
+    """Success of the trials that ran (:func:`graspexp.report.collect.ran`; "not run" when none did)."""
+    df = ran(df)
+    if df.empty:
+        return "not run"
     k, n = int(df["success"].sum()), len(df)
     pct, lo, hi = success_pct(k, n)
     return f"{pct:.1f} % [{lo:.1f}, {hi:.1f}] ({k}/{n})"
@@ -63,6 +68,7 @@ def paired_test(a: pd.DataFrame, b: pd.DataFrame) -> tuple[int, int, float]:
     """(trials only ``a`` won, trials only ``b`` won, McNemar's exact two-sided p-value), matching trials
     by (object, trial); p is 1 when no trial differs."""
     keys = ["object", "trial"]
+    a, b = ran(a), ran(b)  # a trial not run in either set is no win for the other
     m = a[keys + ["success"]].merge(b[keys + ["success"]], on=keys, suffixes=("_a", "_b"))
     only_a = int((m["success_a"] & ~m["success_b"]).sum())
     only_b = int((~m["success_a"] & m["success_b"]).sum())
@@ -144,7 +150,7 @@ def tuning_markdown(sweep: SweepStudy, scored: list[ScoredSet], command: str, pn
         out.append(f"| {obj} | {' | '.join(cells)} |")
     out.append(f"| **all objects** | {' | '.join(f'**{_rate(s.results)}**' for s in scored)} |")
     only_base, only_tuned, p = paired_test(baseline.results, tuned.results)
-    gain = 100.0 * (tuned.results["success"].mean() - baseline.results["success"].mean())
+    gain = 100.0 * (ran(tuned.results)["success"].mean() - ran(baseline.results)["success"].mean())
     out += [
         "",
         f"- {tuned.label} minus {baseline.label}: {gain:+.1f} percentage points; trials only {baseline.label} "

@@ -15,6 +15,8 @@ from pathlib import Path
 
 from filelock import FileLock, Timeout
 
+from graspexp.core.files import write_atomic
+
 
 class RunError(RuntimeError):
     """A job that cannot run as asked: a missing or unreadable input, an unwritable output folder, a
@@ -33,6 +35,12 @@ class DirectoryLock:
     def acquire(self) -> None:
         """Take the lock; RunError naming the holder if another process has it, or the folder if it cannot
         be written."""
+        for path in (Path(self._lock.lock_file), self.holder):
+            if Path(path).is_symlink():  # the lock would truncate, the holder overwrite, its target
+                raise RunError(
+                    f"{path} is a symbolic link; graspexp writes no run file through a link: remove it or "
+                    "choose another output directory"
+                )
         try:
             self.folder.mkdir(parents=True, exist_ok=True)
             self._lock.acquire()
@@ -50,9 +58,8 @@ class DirectoryLock:
                 f"cannot write to the output directory {self.folder}: {exc.strerror or exc}"
             ) from None
         now = datetime.datetime.now().astimezone().isoformat(timespec="seconds")
-        self.holder.write_text(
-            f"pid {os.getpid()} on {socket.gethostname()} since {now}: {' '.join(sys.argv)}\n"
-        )
+        text = f"pid {os.getpid()} on {socket.gethostname()} since {now}: {' '.join(sys.argv)}\n".encode()
+        write_atomic(self.holder, lambda fh: fh.write(text))
 
     def release(self) -> None:
         """Drop the lock and its holder file."""

@@ -9,7 +9,8 @@ from pathlib import Path
 
 from omegaconf import DictConfig, OmegaConf
 
-from graspexp.core.run_layout import hydra_dir
+from graspexp.core.files import write_atomic
+from graspexp.core.run_layout import HYDRA_FILES, hydra_dir, real_folder
 from graspexp.datasets import resolve_root
 from graspexp.run.objects import LoadedObject
 
@@ -62,7 +63,8 @@ def job_metadata(cfg: DictConfig) -> dict[str, str]:
 def trial_metadata(job_meta: dict[str, str], loaded: LoadedObject, trial: int, seed: int) -> dict[str, str]:
     """One trial's log metadata: the job's, the trial's seeds and what its object was made of (the mesh
     file, "" for a procedural one, the SHA-256 of the geometry used with its face count, surface area and
-    volume, the collision method it got, and what was assumed for it: units, mass, area)."""
+    volume, the collision method it got with its cache key and the SHA-256 of the shape itself, the
+    SHA-256 of its grasping area, and what was assumed for it: units, mass, area)."""
     return {
         **job_meta,
         "object": loaded.model.name,
@@ -73,6 +75,8 @@ def trial_metadata(job_meta: dict[str, str], loaded: LoadedObject, trial: int, s
         **loaded.model.mesh_facts,
         "collision_method": loaded.hulls.method,
         "collision_key": loaded.hulls.key,
+        "collision_sha256": loaded.hulls.sha256,
+        "area_sha256": loaded.model.area_sha256,
         "object_notes": "\n".join(loaded.notes),
     }
 
@@ -90,8 +94,12 @@ def write_hydra_record(cfg: DictConfig, run_dir: Path) -> None:
     from hydra.core.hydra_config import HydraConfig
 
     hc = HydraConfig.get()
-    folder = hydra_dir(run_dir)
-    folder.mkdir(parents=True, exist_ok=True)
-    (folder / "config.yaml").write_text(OmegaConf.to_yaml(cfg))
-    (folder / "hydra.yaml").write_text(OmegaConf.to_yaml({"hydra": hc}))
-    (folder / "overrides.yaml").write_text(OmegaConf.to_yaml(list(hc.overrides.task)))
+    folder = real_folder(run_dir, hydra_dir(run_dir))
+    texts = (
+        OmegaConf.to_yaml(cfg),
+        OmegaConf.to_yaml({"hydra": hc}),
+        OmegaConf.to_yaml(list(hc.overrides.task)),
+    )
+    for name, text in zip(HYDRA_FILES, texts, strict=True):  # replaced whole, never through a link
+        data = text.encode()
+        write_atomic(folder / name, lambda fh, data=data: fh.write(data))

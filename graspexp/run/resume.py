@@ -15,11 +15,22 @@ from omegaconf import DictConfig
 
 from graspexp.config.differences import config_differences
 from graspexp.core.outcome import FailureReason, TrialResult, result_from_dict
-from graspexp.core.run_layout import LOCK_NAME, quarantine_path, trials_dir
-from graspexp.datasets.model import ObjectModel
+from graspexp.core.run_layout import (
+    HYDRA_FILES,
+    LOCK_NAME,
+    LinkedRunPathError,
+    check_not_linked,
+    hydra_dir,
+    quarantine_path,
+    real_folder,
+    results_csv,
+    summary_md,
+    trials_dir,
+)
 from graspexp.record import CorruptLogError, iter_trial_logs, read_result
 from graspexp.record.reader import read_metadata
 from graspexp.run.locks import DirectoryLock, RunError
+from graspexp.run.objects import LoadedObject
 
 log = logging.getLogger(__name__)
 
@@ -63,26 +74,54 @@ def check_resumable(cfg: DictConfig, run_dir: Path, move_foreign: bool = True) -
         quarantine(path, run_dir, why)
 
 
-def check_same_meshes(run_dir: Path, models: dict[str, ObjectModel]) -> None:
+def check_same_meshes(run_dir: Path, objects: dict[str, LoadedObject]) -> None:
     """Raise RunError if a log in ``run_dir`` was made on another geometry of its object than this run
-    loads (another data root, a re-download, a rescaled file): resume never mixes trials of two meshes.
-    Logs that record no mesh (written before graspexp recorded it) and unreadable ones are not compared."""
+    loads (another data root, a re-download, a rescaled file), with another collision shape (a cache entry
+    rewritten by someone else) or another grasping area (an edited area spec): resume never mixes trials of
+    two. Values a log does not record (written before graspexp recorded them) and unreadable logs are not
+    compared."""
     for path in iter_trial_logs(run_dir):
         try:
             meta = read_metadata(path) or {}
         except CorruptLogError:
             continue
-        model = models.get(meta.get("object", ""))
-        logged = meta.get("mesh_sha256")
-        if model is None or logged is None or logged == model.mesh_sha256:
+        loaded = objects.get(meta.get("object", ""))
+        if loaded is None:
             continue
-        raise RunError(
-            f"{run_dir} holds trials of {model.name} made on another mesh ({path.relative_to(run_dir)}: "
-            f"{meta.get('mesh_source') or 'procedural'}, sha256 {logged[:12]}{_facts(meta)}; now "
-            f"{model.source or 'procedural'}, sha256 {model.mesh_sha256[:12]}{_facts(model.mesh_facts)}); "
-            f"resume only reuses trials of the same mesh: choose another output directory or delete "
-            f"{trials_dir(run_dir)}"
-        )
+        model = loaded.model
+        logged = meta.get("mesh_sha256")
+        if logged is not None and logged != model.mesh_sha256:
+            raise RunError(
+                f"{run_dir} holds trials of {model.name} made on another mesh ({path.relative_to(run_dir)}: "
+                f"{meta.get('mesh_source') or 'procedural'}, sha256 {logged[:12]}{_facts(meta)}; now "
+                f"{model.source or 'procedural'}, sha256 {model.mesh_sha256[:12]}{_facts(model.mesh_facts)}); "
+                f"resume only reuses trials of the same mesh: choose another output directory or delete "
+                f"{trials_dir(run_dir)}"
+            )
+        for key, now, what in (
+            ("collision_sha256", loaded.hulls.sha256, "collision shape (a changed cache entry?)"),
+            ("area_sha256", model.area_sha256, "grasping area (an edited area spec?)"),
+        ):
+            if meta.get(key) and now and meta[key] != now:
+                raise RunError(
+                    f"{run_dir} holds trials of {model.name} made with another {what} "
+                    f"({path.relative_to(run_dir)}: {key} {meta[key][:12]}, now {now[:12]}); resume only "
+                    f"reuses trials of the same one: choose another output directory or delete {trials_dir(run_dir)}"
+                )
+
+
+def check_run_files(run_dir: Path) -> None:
+    """Raise RunError if a file or folder the job writes in ``run_dir`` is a symbolic link (checked before the
+    first trial; every write checks again): nothing is written through a link planted in a shared
+    directory."""
+    try:
+        for path in (trials_dir(run_dir), results_csv(run_dir), summary_md(run_dir), hydra_dir(run_dir)):
+            check_not_linked(path)
+        if hydra_dir(run_dir).is_dir():
+            for name in HYDRA_FILES:
+                check_not_linked(hydra_dir(run_dir) / name)
+    except LinkedRunPathError as exc:
+        raise RunError(str(exc)) from None
 
 
 def _facts(meta: dict[str, str]) -> str:
@@ -109,6 +148,9 @@ def finished_result(path: Path, run_dir: Path, object_name: str, trial: int) -> 
     if result.reason == FailureReason.ERROR.value:
         quarantine(path, run_dir, f"re-running trial: it ended in an error ({result.error})")
         return None
+    if not result.at_rest and result.reason != FailureReason.NOT_AT_REST.value:
+        quarantine(path, run_dir, "re-running trial: it planned on a moving object (before not_at_rest)")
+        return None
     return result
 
 
@@ -117,7 +159,10 @@ def quarantine(path: Path, run_dir: Path, why: str) -> Path:
     deleted: a foreign or damaged file may be someone's data) and log ``why`` with where it went."""
     stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y%m%dT%H%M%S%fZ")
     target = quarantine_path(run_dir, path, stamp)
-    target.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        real_folder(run_dir, target.parent)
+    except LinkedRunPathError as exc:
+        raise RunError(str(exc)) from None
     os.replace(path, target)
     log.warning("%s; %s moved to %s", why, path, target)
     return target

@@ -24,7 +24,7 @@ from graspexp.run.job_config import make_ready
 from graspexp.run.objects import LoadedObject, load_models
 from graspexp.run.prepare import prepare_shapes
 from graspexp.run.provenance import write_hydra_record
-from graspexp.run.resume import check_resumable, check_same_meshes, job_lock, kept_results
+from graspexp.run.resume import check_resumable, check_run_files, check_same_meshes, job_lock, kept_results
 from graspexp.run.summary import objective_value, write_summary
 from graspexp.run.trial_loop import run_object_trials
 
@@ -59,7 +59,8 @@ def _run(cfg: DictConfig, run_dir: Path, on_accepted: Callable[[DictConfig, Path
     models, unusable = load_models(cfg, objects)
     with job_lock(run_dir):
         check_resumable(cfg, run_dir)
-        check_same_meshes(run_dir, {name: loaded.model for name, loaded in models.items()})
+        check_same_meshes(run_dir, models)
+        check_run_files(run_dir)
         if on_accepted is not None:
             on_accepted(cfg, run_dir)
         return _run_trials(cfg, run_dir, objects, models, unusable, wall0, cpu0)

@@ -45,6 +45,31 @@ def _directions(direction: Any) -> list[str]:
     return [str(getattr(d, "name", d)) for d in items]
 
 
+def _refuse(message: str) -> None:
+    """A study that cannot start or resume: one ``graspexp: error:`` line, exit status 2."""
+    print(f"graspexp: error: {message}", file=sys.stderr)
+    raise SystemExit(2)
+
+
+def study_inputs(config: DictConfig) -> dict[str, str]:
+    """What a study's trials read besides their config: the data root and the SHA-256 of each selected
+    object's mesh (as every trial log records it), recorded with the study and compared on resume: the
+    same command on another data root (``record=false`` leaves no log to compare) must not mix meshes."""
+    from graspexp.datasets import DatasetError, job_object, resolve_root, select_objects
+
+    out = {"data_root": str(resolve_root(config.dataset).resolve())}
+    try:
+        names = select_objects(config.dataset, config.objects)
+    except DatasetError:
+        return out  # the first job says what is missing
+    for name in names:
+        try:
+            out[f"mesh.{name}"] = job_object(config, name).mesh_sha256
+        except DatasetError as exc:
+            out[f"mesh.{name}"] = f"unusable: {str(exc)[:80]}"
+    return out
+
+
 class OptunaStudy(Callback):
     """Resume an Optuna study stored with its sweep, baseline first; save its history and plots at the end."""
 
@@ -55,6 +80,7 @@ class OptunaStudy(Callback):
             return
         from graspexp.report.study import (  # here, not at the top: every job instantiates this callback
             FINISHED_STATES,
+            recorded_inputs,
             recorded_overrides,
             searched_keys,
             sqlite_path,
@@ -71,26 +97,42 @@ class OptunaStudy(Callback):
                 if old.get(k) != new.get(k)
             ]
             if changed:
-                print(
-                    f"graspexp: error: {config.hydra.sweep.dir} holds a study of another command ("
-                    f"{'; '.join(changed)}); a study resumes only with the same overrides: use another "
-                    "hydra.sweep.dir",
-                    file=sys.stderr,
+                _refuse(
+                    f"{config.hydra.sweep.dir} holds a study of another command ({'; '.join(changed)}); a "
+                    "study resumes only with the same overrides: use another hydra.sweep.dir"
                 )
-                raise SystemExit(2)
         db = sqlite_path(str(storage))
         Path(config.hydra.sweep.dir).mkdir(parents=True, exist_ok=True)
         if db is not None:
             db.parent.mkdir(parents=True, exist_ok=True)
+        inputs = study_inputs(config)
+        recorded_in = recorded_inputs(Path(config.hydra.sweep.dir))
+        changed_in = [k for k in sorted(recorded_in) if recorded_in[k] != inputs.get(k)]
+        if recorded_in and changed_in:
+            key = changed_in[0]
+            _refuse(
+                f"{config.hydra.sweep.dir} holds a study made on other inputs ({key}: "
+                f"{recorded_in.get(key, '<absent>')[:60]} in the study, {inputs.get(key, '<absent>')[:60]} now); "
+                "a study resumes only on the same data root and meshes: use another hydra.sweep.dir"
+            )
         import optuna
 
-        study = optuna.create_study(
-            study_name=sweeper.study_name,
-            storage=str(storage),
-            directions=_directions(sweeper.direction),
-            load_if_exists=True,
+        try:
+            study = optuna.create_study(
+                study_name=sweeper.study_name,
+                storage=str(storage),
+                directions=_directions(sweeper.direction),
+                load_if_exists=True,
+            )
+        except Exception as exc:  # a damaged or foreign database: SQLAlchemy's and Optuna's many types
+            why = " ".join(str(exc).split())[:200]
+            _refuse(
+                f"the study's storage {storage} cannot be opened ({type(exc).__name__}: {why}); move the damaged "
+                "file aside or use another hydra.sweep.dir"
+            )
+        write_study_record(
+            Path(config.hydra.sweep.dir), str(storage), str(sweeper.study_name), overrides, inputs
         )
-        write_study_record(Path(config.hydra.sweep.dir), str(storage), str(sweeper.study_name), overrides)
         keys = searched_keys(overrides)
         trials = study.get_trials(deepcopy=False)
         if not trials:

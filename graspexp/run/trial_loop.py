@@ -10,7 +10,7 @@ from omegaconf import DictConfig
 from tqdm import tqdm
 
 from graspexp.core.outcome import FailureReason, TrialResult
-from graspexp.core.run_layout import trial_log_path
+from graspexp.core.run_layout import LinkedRunPathError, real_folder, trial_log_path
 from graspexp.core.seeding import trial_seed
 from graspexp.datasets import ObjectError
 from graspexp.record import trial_recorder
@@ -45,6 +45,13 @@ def run_object_trials(
     if loaded is None:
         ready, failed = load_models(cfg, [object_name])
         loaded = ready.get(object_name) or failed[object_name]
+    first = trial_log_path(run_dir, object_name, 0)
+    try:  # the object's folder of logs: never a link to somewhere else (a shared sweep directory)
+        real_folder(run_dir, first.parent)
+    except LinkedRunPathError as exc:
+        raise RunError(str(exc)) from None
+    except OSError as exc:
+        raise RunError(_write_failure(first, exc)) from None
     if isinstance(loaded, str):
         return _unusable_object_trials(cfg, object_name, run_dir, loaded, bar)
     results = []
@@ -54,7 +61,6 @@ def run_object_trials(
         result = finished_result(path, run_dir, object_name, i)
         if result is None:
             try:
-                path.parent.mkdir(parents=True, exist_ok=True)
                 meta = trial_metadata(job_meta, loaded, i, seed)
                 with trial_recorder(path if cfg.record else None, meta, plain) as rec:
                     try:
@@ -100,7 +106,6 @@ def _unusable_object_trials(
         seed = trial_seed(plain, object_name, i)
         result = error_result(cfg, object_name, i, seed, ObjectError(reason))
         path = trial_log_path(run_dir, object_name, i)
-        path.parent.mkdir(parents=True, exist_ok=True)
         meta = unusable_trial_metadata(job_meta, object_name, i, seed)
         with trial_recorder(path if cfg.record else None, meta, plain) as rec:
             rec.result(0.0, result.to_dict())

@@ -143,17 +143,17 @@ def collision_shape(mesh: trimesh.Trimesh, cfg: SimConfig) -> CollisionShape:
         arrays = {f"{kind}_{i}": a for i, (v, f) in enumerate(parts) for kind, a in (("v", v), ("f", f))}
         digests = {"sha256": _parts_digest(convex, parts), "obj_sha256": hashlib.sha256(obj_text).hexdigest()}
         write_atomic(path, lambda fh: np.savez(fh, convex=convex, n_parts=len(parts), **digests, **arrays))
-        entry = (convex, tuple(parts), digests["obj_sha256"])
-    convex, parts, obj_sha256 = entry
+        entry = (convex, tuple(parts), digests["obj_sha256"], digests["sha256"])
+    convex, parts, obj_sha256, sha256 = entry
     if convex:
-        return CollisionShape(params["method"], parts, True, key=key)
+        return CollisionShape(params["method"], parts, True, key=key, sha256=sha256)
     obj = path.with_suffix(".obj")  # OBJ: SAPIEN 3.0.3 crashes cooking some binary PLY files (16k faces)
     if not obj.is_file() or hashlib.sha256(obj.read_bytes()).hexdigest() != obj_sha256:
         if obj.exists():
             log.warning("collision cache file %s does not match its checksum; rewriting it", obj)
         text = _obj_text(parts[0])
         write_atomic(obj, lambda fh: fh.write(text))
-    return CollisionShape(params["method"], parts, False, obj, key=key)
+    return CollisionShape(params["method"], parts, False, obj, key=key, sha256=sha256)
 
 
 def _obj_text(part: tuple[np.ndarray, np.ndarray]) -> bytes:
@@ -168,8 +168,10 @@ def _parts_digest(convex: bool, parts) -> str:
     return h.hexdigest()
 
 
-def _read_entry(path: Path) -> tuple[bool, tuple, str] | None:
-    """(convex, parts, OBJ checksum) of an intact cache entry; None when absent, unreadable or damaged."""
+def _read_entry(path: Path) -> tuple[bool, tuple, str, str] | None:
+    """(convex, parts, OBJ checksum, parts' checksum) of an intact cache entry; None when absent,
+    unreadable or damaged (an entry rewritten with a matching checksum is intact: the checksum guards
+    against damage, not against another writer; the logs record the parts' checksum, module doc)."""
     try:
         with np.load(path) as data:
             n, convex = int(data["n_parts"]), bool(data["convex"])
@@ -179,7 +181,7 @@ def _read_entry(path: Path) -> tuple[bool, tuple, str] | None:
         return None
     except Exception:  # a truncated zip, a missing array, a bad header: rebuilt by the caller
         return None
-    return (convex, parts, obj_sha256) if _parts_digest(convex, parts) == digest else None
+    return (convex, parts, obj_sha256, digest) if _parts_digest(convex, parts) == digest else None
 
 
 def shape_with_fallback(mesh: trimesh.Trimesh, cfg: SimConfig) -> tuple[CollisionShape, str]:
@@ -265,6 +267,11 @@ def _closed_mesh(mesh: trimesh.Trimesh, params: dict) -> tuple[np.ndarray, np.nd
     from graspexp.sim.collision_accuracy import signed_distance_m
 
     kept = [c for c in mesh.split(only_watertight=False) if c.area >= params["min_part_area"] * mesh.area]
+    if not kept:  # a triangle soup: every connected part is as small as scan debris
+        raise RepairError(
+            f"no connected part of the mesh holds {params['min_part_area']:g} of its area (sim.mesh_min_part_area): "
+            "its faces share no edges (a triangle soup?); use sim.collision_method=coacd for this object"
+        )
     area = sum(c.area for c in kept)
     mesh_pts, _ = trimesh.sample.sample_surface(mesh, 2000, seed=0)
     budget = params["max_faces"]

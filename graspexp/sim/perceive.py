@@ -13,11 +13,11 @@ import numpy as np
 
 from graspexp.config import JobConfig
 from graspexp.config.plugins import get_plugin
+from graspexp.core.geometry import pose_error
 from graspexp.core.seeding import rng_for
 from graspexp.datasets.model import ObjectModel
 from graspexp.perception import Observation
 from graspexp.perception.camera import BoxBody, MeshBody
-from graspexp.planning.stability import pose_error
 from graspexp.sim.scene import FLOOR_HALF_SIZE_M
 
 TARGET_ID = 1

@@ -22,6 +22,9 @@ class CollisionShape:
     """The OBJ file of the closed mesh that SAPIEN cooks once per process; None for hulls."""
     key: str = ""
     """The cache key it was built under (mesh content, method parameters, library versions); "" if uncached."""
+    sha256: str = ""
+    """SHA-256 of the shape itself (its parts' float32 vertices and int64 faces): what every trial that used
+    it collided with, recorded in each log ("" if not computed)."""
 
     def meshes(self) -> list[trimesh.Trimesh]:
         """The parts as triangle meshes (object frame, metres)."""

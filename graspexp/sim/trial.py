@@ -377,6 +377,8 @@ def run_trial(ctx: TrialContext) -> TrialResult:
     sim: _Sim | None = None
     try:
         sim = _drop_until_on_support(ctx, res, timings)
+        if not res.at_rest:
+            raise TrialFailed(FailureReason.NOT_AT_REST, "still moving when sim.settle_max_s ran out")
         with sim.timed("plan"):
             grasp = _plan(ctx, sim, res)
         res.grasp_cost, res.grasp_width_m, res.n_feasible = grasp.cost, grasp.width_m, grasp.n_feasible
@@ -416,7 +418,7 @@ def _drop_until_on_support(ctx: TrialContext, res: TrialResult, timings: dict) -
             res.at_rest = at_rest
             if at_rest:
                 sim.phase("settled", {"redrops": attempt})
-            else:  # planned on a moving object: said, not hidden
+            else:  # never planned on a moving object: a failure class of its own
                 speed, spin = (float(v) ** 0.5 for v in sim.speed_sq)
                 info = {
                     "redrops": attempt,

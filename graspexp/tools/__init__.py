@@ -10,6 +10,7 @@ TOOLS: tuple[str, ...] = (
     "readings",
     "benchmark",
     "download",
+    "download_checkpoint",
     "prepare",
     "area",
     "config_reference",
@@ -23,5 +24,6 @@ TOOLS: tuple[str, ...] = (
     "bench.compare_runs",
     "bench.plan_grasps",
     "bench.registration",
+    "bench.learned",
 )
 """Every tool: ``python -m graspexp NAME`` runs ``graspexp.tools.NAME.main``."""

@@ -21,7 +21,7 @@ from collections.abc import Callable, Sequence
 from omegaconf import DictConfig
 
 from graspexp.config import ConfigError
-from graspexp.config.compose import expand_sweeps, one_line, search_ranges
+from graspexp.config.compose import expand_sweeps, one_line, search_problems, search_ranges
 from graspexp.config.registry import group_options
 from graspexp.run.job_config import compose_job
 from graspexp.run.launchers import submitit_guard
@@ -117,6 +117,9 @@ def check_overrides(overrides: Sequence[str], multirun: bool = True) -> None:
         fail(
             f"{' '.join(ranges)} is a search range, which only an Optuna study draws from: add hydra/sweeper=study"
         )
+    problems = search_problems(overrides)
+    if problems:
+        fail(problems[0])
     for combo in combos:
         compose_checked(combo)
 

@@ -33,7 +33,7 @@ def main(argv: list[str] | None = None) -> int:
         report = build_report(args.dir)
     except MixedConfigError as exc:
         return _error(str(exc))
-    if report.collected.results.empty and not report.collected.unreadable:
+    if report.collected.results.empty and not report.collected.unreadable and report.collected.not_run.empty:
         return _error(f"no trial logs (trials/*/*.mcap) below {args.dir}")
     out = args.out if args.out is not None else args.dir / "report"
     try:
@@ -43,6 +43,12 @@ def main(argv: list[str] | None = None) -> int:
             f"cannot write the report to {out}: {exc.strerror or exc}; choose another folder with --out"
         )
     print(f"\nreport written to {out}", file=sys.stderr)
+    if report.collected.results.empty and not report.collected.not_run.empty:
+        print(
+            f"graspexp report: no trial below {args.dir} ran to an outcome (every one is listed as not run)",
+            file=sys.stderr,
+        )
+        return 1
     if report.collected.unreadable:
         n = len(report.collected.unreadable)
         print(

@@ -170,12 +170,12 @@ def test_each_planner_has_its_own_schema_and_the_names_come_from_the_registry():
         compose_cfg("planner=schema_planner_optimal")  # the schemas are not options of the group
     with pytest.raises(
         ConfigError,
-        match=r"^planner.name has no value: choose an option, planner= one of antipodal, antipodal_area, antipodal_area_pads, obb,",
+        match=r"^planner.name has no value: choose an option, planner= one of antipodal, antipodal_area, antipodal_area_pads, antipodal_view, obb,",
     ):
         validate(compose_cfg("planner.name=???"))
     with pytest.raises(
         ConfigError,
-        match=r"^planner.name='nope' is unknown: expected one of antipodal, antipodal_area, antipodal_area_pads, obb,",
+        match=r"^planner.name='nope' is unknown: expected one of antipodal, antipodal_area, antipodal_area_pads, antipodal_view, obb,",
     ):
         validate(compose_cfg("planner.name=nope"))
 

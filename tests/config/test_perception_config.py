@@ -5,7 +5,7 @@ import importlib.util
 import re
 
 import pytest
-from conftest import compose_cfg
+from helpers.config import compose_cfg
 
 from graspexp.config import ConfigError, validate
 from graspexp.config import perception as P

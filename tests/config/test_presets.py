@@ -10,7 +10,7 @@ import yaml
 
 from graspexp.config.job import JobConfig
 from graspexp.config.plugins import get_plugin
-from graspexp.config.registry import CONF_DIR, SCHEMAS
+from graspexp.config.registry import CONF_DIR, NESTED_SCHEMAS, SCHEMAS
 
 CONF = Path(CONF_DIR)
 HYDRA_OWN = "hydra"
@@ -30,7 +30,7 @@ def _schema(path: Path, data: dict) -> type:
         return JobConfig
     if name.startswith("schema_planner_"):
         return get_plugin(name.removeprefix("schema_planner_")).plugin.config
-    return SCHEMAS[name.removeprefix("schema_")]
+    return {**SCHEMAS, **NESTED_SCHEMAS}[name.removeprefix("schema_")]
 
 
 def _default(field: dataclasses.Field) -> object:

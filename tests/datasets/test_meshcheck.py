@@ -125,7 +125,9 @@ def test_bop_model_must_match_its_published_size(data_root: Path, tmp_path: Path
     info = json.loads((models / "models_info.json").read_text())
     info["1"]["size_z"] *= 2  # a model of another object, or another scale
     (models / "models_info.json").write_text(json.dumps(info))
-    with pytest.raises(DatasetError, match=r"extents \[75.87, 77.6, 91.77\] differ from the published size"):
+    with pytest.raises(
+        DatasetError, match=r"extents \[75.87, 77.6, 91.77\] mm differ from the published size"
+    ):
         load_object(_cfg("linemod", tmp_path), "ape", 64, 0)
 
 
@@ -158,3 +160,16 @@ def test_an_ascii_ply_with_more_rows_than_declared_is_refused(tmp_path):
         DatasetError, match=r"its header declares 8 vertex, 12 face \(20 rows\), the file holds 21"
     ):
         load_object(cfg, "cube", 16, 0)
+
+
+def test_a_google_16k_model_at_another_scale_is_refused(data_root: Path, tmp_path: Path) -> None:
+    path = tmp_path / "ycb" / "011_banana" / "google_16k" / "textured.obj"
+    path.parent.mkdir(parents=True)
+    text = (data_root / "ycb" / "011_banana" / "google_16k" / "textured.obj").read_text()
+    lines = [
+        "v " + " ".join(f"{0.1 * float(x):.7g}" for x in ln.split()[1:4]) if ln.startswith("v ") else ln
+        for ln in text.splitlines()
+    ]
+    path.write_text("\n".join(lines) + "\n")  # a 1.8 cm banana: inside [5 mm, 1 m], the published mass
+    with pytest.raises(DatasetError, match=r"mm differ from the published size \[108.9, 178.4, 36.7\] mm"):
+        load_object(_cfg("ycb", tmp_path), "011_banana", 64, 0)

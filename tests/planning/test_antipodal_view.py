@@ -5,8 +5,8 @@ import dataclasses
 
 import numpy as np
 import pytest
+from helpers.planning import full_view
 from omegaconf import OmegaConf
-from test_planner_common import full_view
 
 from graspexp.config.compose import compose_config
 from graspexp.config.plugins import get_plugin

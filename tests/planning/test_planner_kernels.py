@@ -227,6 +227,22 @@ def test_kernel_cache_is_per_user_private_and_survives_an_unusable_one(tmp_path)
     assert (tmp_path / "home" / "graspexp" / "numba").stat().st_mode & 0o777 == 0o700
 
 
+def test_a_numba_cache_dir_others_can_write_is_not_used(tmp_path):
+    """NUMBA_CACHE_DIR set by the user is used only if it is private too: numba's index files are pickles,
+    and a world-writable folder would let anyone run code in the next process (issue 39)."""
+    shared = tmp_path / "numba"
+    shared.mkdir()
+    shared.chmod(0o777)
+    script = "from graspexp.planning import kernels\nprint(kernels._CACHE)\n"
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(shared)}
+    proc = subprocess.run(
+        [sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=120
+    )
+    assert proc.returncode == 0 and proc.stdout.split() == ["False"], proc.stderr
+    assert "NUMBA_CACHE_DIR) is not private to this user" in proc.stderr
+    assert "set NUMBA_CACHE_DIR" not in proc.stderr  # the advice is never "set it" to anything
+
+
 # --- the whole plan on the real meshes ---
 
 

@@ -6,8 +6,8 @@ import pytest
 import trimesh
 from helpers.config import compose_cfg
 from helpers.objects import write_urdf_gripper
+from helpers.planning import full_view
 from omegaconf import OmegaConf
-from test_planner_common import full_view
 
 from graspexp.config.plugins import LoadedPlanner, load_planners
 from graspexp.grippers import GripperGeometry
@@ -15,7 +15,13 @@ from graspexp.planning import PlanRequest, plan
 from graspexp.planning.collision import cloud_hits, frame_from_axes, lowest_z
 from graspexp.run.job_config import make_ready
 
-PLANNERS = tuple(sorted(n for n, p in load_planners().items() if isinstance(p, LoadedPlanner)))
+PLANNERS = tuple(
+    sorted(
+        n
+        for n, p in load_planners().items()
+        if isinstance(p, LoadedPlanner) and not p.plugin.needs_observation
+    )
+)
 
 
 def _gripper(*overrides: str):

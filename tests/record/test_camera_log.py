@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import strictly_valid
+from helpers.logs import strictly_valid
 
 from graspexp.record import read_trial
 

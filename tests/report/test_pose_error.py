@@ -26,3 +26,25 @@ def test_bins_and_rates():
 
 def test_truth_runs_have_no_table():
     assert success_by_pose_error(pd.DataFrame({"planner": ["optimal"], "success": [True]})).empty
+
+
+def test_camera_table_columns_split_by_registered_pose():
+    from graspexp.report.camera import setting_table
+
+    rows = []
+    for planner, adds in (("optimal", math.nan), ("optimal", 2.0), ("antipodal_view", math.nan)):
+        for trial in range(10):
+            rows.append(
+                {"mode": "bin", "rot": "z", "object": "025_mug", "planner": planner, "trial": trial,
+                 "success": trial < (9 if math.isnan(adds) else 7), "pose_adds_mm": adds}
+            )  # fmt: skip
+    table = setting_table(pd.DataFrame(rows), "bin", "z").set_index("object")
+    assert (
+        table.loc["Mug", "optimal, exact pose"] == "90"
+        and table.loc["Mug", "optimal, registered pose"] == "70"
+    )
+    assert (
+        table.loc["Mug", "antipodal_view, camera cloud"] == "90" and table.loc["Mug", "paper: ours"] == "80"
+    )
+    assert table.loc["Average", "optimal, registered pose"].endswith("n=10")
+    assert table.loc["Cleanser B.", "antipodal, full model"] == "-"

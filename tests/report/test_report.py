@@ -1,5 +1,6 @@
 """Report tier: paper data, Wilson intervals, and the report built from hand-made MCAP logs (no simulator)."""
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -111,7 +112,8 @@ def sweep_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_collect_reads_every_log(sweep_dir: Path) -> None:
     col = collect(sweep_dir)
-    assert len(col.results) == sum(len(v) for v in CELLS.values()) == 40
+    assert len(col.results) + len(col.not_run) == sum(len(v) for v in CELLS.values()) == 40
+    assert set(col.not_run["reason"]) == {"error"} and len(col.not_run) == 2  # never scored
     assert col.unreadable == [] and col.duplicates == []
 
 
@@ -134,8 +136,9 @@ def test_table1_exact_percentages_intervals_and_deltas(sweep_dir: Path) -> None:
     assert (mug["top_reason"], mug["top_reason_n"]) == ("", 0)
     xyz = _cell(t1, "Cleanser B.", "collab", "xyz")
     assert (xyz["top_reason"], xyz["top_reason_n"]) == ("dropped", 5)
+    assert xyz["n"] == 8  # the two trials that ended in an error were not run: no failures of the grasp
     assert (xyz["ours_pct"], xyz["lo_pct"], xyz["hi_pct"], xyz["paper_pct"]) == pytest.approx(
-        (0, 0, 27.8, 90), abs=0.05
+        (0, 0, 32.4, 90), abs=0.05
     )
     # objects without logs stay in the table as n/a, with the paper's value
     meat = _cell(t1, "Meat Can", "collab", "z")
@@ -335,9 +338,9 @@ def test_agreement_flags_cells_below_the_paper_with_their_failure_reason(sweep_d
     bleach_z = cells.loc[("Cleanser B.", "collab", "z")]
     assert (bleach_z["ours_k"], bleach_z["ours_n"], bleach_z["paper_k"]) == (9, 10, 10)
     assert bleach_z["p_below"] == pytest.approx(0.5) and not bleach_z["flagged"]
-    bleach_xyz = cells.loc[("Cleanser B.", "collab", "xyz")]  # 0/10 against the paper's 9/10
+    bleach_xyz = cells.loc[("Cleanser B.", "collab", "xyz")]  # 0/8 run (2 not run) against the paper's 9/10
     assert bleach_xyz["flagged"] and bleach_xyz["top_reason"] == "dropped"
-    assert bleach_xyz["p_below"] == pytest.approx(p_below(0, 10, 9))
+    assert bleach_xyz["p_below"] == pytest.approx(p_below(0, 8, 9))
     ape = ag["linemod"].objects.set_index("label").loc["Ape"]  # 5/10 against 9/10: p = 0.07
     assert ape["p_below"] == pytest.approx(p_below(5, 10, 9)) and not ape["flagged"]
     # One pooled row per setting: every trial of the paper objects we ran against their printed rates.
@@ -406,6 +409,7 @@ def test_collect_reads_results_csv_only_where_a_run_has_no_logs(sweep_dir: Path,
                 "rot": "z",
                 "object": "025_mug",
                 "trial": t,
+                "seed": t,
             }
             | {"success": t % 2 == 0, "reason": "" if t % 2 == 0 else "dropped", "timings_s": "{'plan': 0.5}"}
             for t in range(4)
@@ -417,3 +421,57 @@ def test_collect_reads_results_csv_only_where_a_run_has_no_logs(sweep_dir: Path,
     assert list(rows["success"]) == [True, False, True, False]
     assert set(rows["trans_mm"]) == {10.0} and set(rows["plan_ms"]) == {500.0}
     assert set(col.results.loc[col.results["path"] != "", "trans_mm"]) == {0.0}
+
+
+@pytest.mark.parametrize(
+    "field, value, match",
+    [
+        ("success", "yes", r"row 3: success='yes' is not <class 'bool'>"),
+        ("trial", str(10**30), r"row 3: trial='1000000000000000000000000000000' is not <class 'int'>"),
+        ("reason", "exploded", r"row 3: result field reason='exploded' is not a failure reason"),
+        ("timings_s", "*a", r"row 3: timings_s='\*a' is not"),
+    ],
+)
+def test_a_bad_results_csv_is_unreadable_in_one_line_never_a_traceback(tmp_path, field, value, match):
+    rows = [
+        {"dataset": "ycb", "object": "025_mug", "mode": "bin", "rot": "z", "planner": "optimal", "trial": t,
+         "seed": t, "success": False, "reason": "dropped", "timings_s": "{'plan': 0.5}"}
+        for t in range(2)
+    ]  # fmt: skip
+    rows[1][field] = value
+    pd.DataFrame(rows).to_csv(tmp_path / "results.csv", index=False)
+    col = collect(tmp_path)
+    assert col.results.empty and len(col.unreadable) == 1
+    ((path, why),) = col.unreadable
+    assert path == tmp_path / "results.csv" and re.search(match, why) and "\n" not in why
+
+
+@pytest.mark.parametrize(
+    "metas, mode, match",
+    [  # one cache key, two shapes (a rewritten shared cache entry), in two settings of one report
+        ([{"collision_key": "k", "collision_sha256": s} for s in ("a" * 64, "b" * 64)], ("z", "xyz"), "two collision shapes"),
+        ([{"area_sha256": s} for s in ("a" * 64, "b" * 64)], ("z", "z"), "two grasping areas"),
+    ],
+)  # fmt: skip
+def test_a_report_never_merges_two_collision_shapes_or_areas(tmp_path, capsys, metas, mode, match) -> None:
+    for i, (meta, rot) in enumerate(zip(metas, mode, strict=True)):
+        path = tmp_path / f"run{i}" / "trials" / "025_mug" / f"{i:03d}.mcap"
+        with TrialRecorder(path, {"config_yaml": "{}", **meta}) as rec:
+            rec.result(0.0, _result("ycb", "025_mug", "collab", rot, i, None, 0.05))
+    assert report_main([str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"graspexp report: error: trials of 025_mug used {match}") and "\n" not in err
+
+
+def test_a_trial_that_never_came_to_rest_is_its_own_failure_class(tmp_path: Path) -> None:
+    """Logs from before ``not_at_rest`` existed planned on the moving object and may say success: the
+    report counts them as ``not_at_rest``, never as a success or a grasp failure."""
+    for i, reason in enumerate((None, "no_contact", None)):
+        result = _result("ycb", "025_mug", "collab", "z", i, reason, 0.05) | {"at_rest": i == 2}
+        with TrialRecorder(
+            tmp_path / "run" / "trials" / "025_mug" / f"{i:03d}.mcap", {"config_yaml": "{}"}
+        ) as rec:
+            rec.result(0.0, result)
+    report = build_report(tmp_path)
+    row = report.failures.set_index(["dataset", "mode", "rot"]).loc[("ycb", "collab", "z")]
+    assert (row["trials"], row["success"], row["not_at_rest"], row["no_contact"]) == (3, 1, 2, 0)

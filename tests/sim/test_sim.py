@@ -186,6 +186,7 @@ def test_a_settle_cap_that_runs_out_is_said_not_logged_as_settled():
     capture = ContactCapture()
     res = run_trial(_ctx("sim.settle_min_s=0.01", "sim.settle_max_s=0.02", recorder=capture))
     assert res.at_rest is False and "settle_timeout" in capture.phases and "settled" not in capture.phases
+    assert (res.success, res.reason, res.n_feasible) == (False, "not_at_rest", 0)  # never planned on it
     capture = ContactCapture()
     res = run_trial(_ctx(recorder=capture))
     assert res.at_rest is True and "settled" in capture.phases and "settle_timeout" not in capture.phases

@@ -138,3 +138,57 @@ def test_split_and_objects_together_are_refused() -> None:
     proc = _graspexp("dataset.split=train", "objects=[can]", ok=False)
     assert proc.returncode == 2
     assert proc.stderr.strip().endswith("both choose the objects; give one of them")
+
+
+@pytest.mark.parametrize(
+    "override, message",
+    [
+        (
+            "cost.table_offset=interval(0.5, 0.01)",
+            "the search range's lower end 0.5 is not below its upper end 0.01",
+        ),
+        ("hydra.sweeper.n_trials=0", "the number of trials of a study must be a positive integer"),
+    ],
+)
+def test_a_study_that_cannot_start_is_one_line_and_leaves_nothing(tmp_path: Path, override, message) -> None:
+    out = tmp_path / "sweep"
+    proc = _graspexp("-m", *STUDY, override, f"hydra.sweep.dir={out}", ok=False)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    assert proc.stderr.strip() == f"graspexp: error: {override}: {message}"
+    assert not out.exists()  # no optuna.db, no lock left behind
+
+
+def test_a_damaged_study_database_is_one_line(tmp_path: Path) -> None:
+    out = tmp_path / "sweep"
+    out.mkdir()
+    (out / "optuna.db").write_bytes(b"not a database" * 100)
+    proc = _graspexp("-m", *STUDY, "hydra.sweeper.n_trials=1", f"hydra.sweep.dir={out}", ok=False)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr[-2000:]
+    (line,) = [ln for ln in proc.stderr.splitlines() if ln.startswith("graspexp: error:")]
+    assert "optuna.db cannot be opened (DatabaseError" in line and "move the damaged file aside" in line
+    assert not list(out.glob("*/results.csv"))  # no trial ran
+
+
+def test_a_study_resumed_on_another_data_root_is_refused(tmp_path: Path) -> None:
+    from graspexp.report.study import write_study_record
+
+    out = tmp_path / "sweep"
+    out.mkdir()
+    overrides = [o for o in STUDY if not o.startswith("hydra")] + ["hydra.sweeper.n_trials=1"]
+    task = [o for o in overrides if not o.startswith("hydra")]
+    write_study_record(out, f"sqlite:///{out}/optuna.db", "graspexp", task, {"data_root": "/elsewhere"})
+    proc = _graspexp("-m", "hydra/sweeper=study", *overrides, f"hydra.sweep.dir={out}", ok=False)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr[-2000:]
+    (line,) = [ln for ln in proc.stderr.splitlines() if ln.startswith("graspexp: error:")]
+    assert "holds a study made on other inputs (data_root: /elsewhere in the study" in line
+    assert not list(out.glob("*/results.csv"))
+
+
+def test_an_unrun_object_is_not_a_failure_in_the_tuning_report() -> None:
+    from graspexp.report.tuning import _rate, paired_test
+
+    rows = [("ape", 0, False, "error"), ("can", 0, True, None), ("can", 1, False, "dropped")]
+    df = pd.DataFrame(rows, columns=["object", "trial", "success", "reason"])
+    assert _rate(df[df["object"] == "ape"]) == "not run"
+    assert _rate(df).endswith("(1/2)")
+    assert paired_test(df, df.assign(success=True)) == (0, 1, 1.0)

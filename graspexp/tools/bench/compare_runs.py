@@ -5,7 +5,7 @@ Every ``results.csv`` under BEFORE is matched with the file at the same relative
 ``--planner OLD=NEW``: a preset renamed between the runs, ``planner=OLD`` in the path and ``OLD`` in the
 ``planner`` column stand for ``NEW``), and
 every row (keyed by object and trial) is compared cell by cell as text, so a float that changed in its last
-digit counts. Wall-clock timing columns (``timings_s*``) are ignored, and so is a column only one side has (a
+digit counts. Timing columns (wall-clock ``timings_s*``, CPU ``registration_cpu_s``) are ignored, and so is a column only one side has (a
 result field added between the runs; named in the output). Exit status 0 when every row is
 identical, 1 otherwise (the differing cells are printed).
 """
@@ -16,8 +16,8 @@ from pathlib import Path
 
 from graspexp.tools.cli import tool_parser
 
-IGNORED_PREFIXES = ("timings_s",)
-"""Columns that measure wall time: they differ between runs of the same config."""
+IGNORED_PREFIXES = ("timings_s", "registration_cpu_s")
+"""Columns that measure time (wall, or CPU): they differ between runs of the same config."""
 
 
 def _rows(path: Path) -> dict[tuple[str, str], dict[str, str]]:

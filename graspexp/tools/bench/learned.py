@@ -1,0 +1,113 @@
+"""Inference time per plan of a learned planner (``planner=vgn``) on Table 1's YCB objects, CPU only.
+
+Usage::
+
+    GRASPEXP_DATA=... GRASPEXP_CHECKPOINTS=... python -m graspexp bench.learned [--runs 10]
+        [planner=vgn] [gripper=panda] [mode=bin] [objects=[...]] [key=value ...]
+
+Each object stands upright on the support (:mod:`graspexp.run.upright`) and the simulated depth camera
+renders it once (``perception.camera.*``, the trial's own rendering and noise, :func:`graspexp.sim.perceive`);
+then ``--runs`` plans on that observation are timed, on the wall clock and as CPU time of this process
+(torch's threads included; ``planner.threads`` sets how many). One row per object: p50 and p95 of the whole
+plan, and the p50 of its two steps as the planner logs them (``fuse``: the depth views into the TSDF;
+``infer``: the network's forward pass). The first plan of the process (torch's import, the checkpoint's
+hash check and load) is reported apart. Extra ``key=value`` arguments are Hydra overrides.
+"""
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import dataclasses  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from collections.abc import Sequence  # noqa: E402
+
+import numpy as np  # noqa: E402
+from omegaconf import OmegaConf  # noqa: E402
+
+from graspexp.core.seeding import trial_seed  # noqa: E402
+from graspexp.datasets import DatasetError, job_object  # noqa: E402
+from graspexp.planning import NoFeasibleGrasp, PlanRequest, plan  # noqa: E402
+from graspexp.run.upright import UPRIGHT_TRIAL, upright_request  # noqa: E402
+from graspexp.sim.perceive import perceive  # noqa: E402
+from graspexp.tools.cli import compose_checked, fail, tool_parser  # noqa: E402
+
+PROG = "graspexp bench.learned"
+DEFAULTS = ("planner=vgn", "gripper=panda", "dataset=ycb", "mode=bin")
+"""The bench's job unless overridden: VGN with the gripper it was trained for, Table 1's objects."""
+
+
+def observed_request(cfg, name: str) -> PlanRequest:
+    """Object ``name`` upright on the support, with the camera's observation of it (as a trial renders it)."""
+    model = job_object(cfg, name)
+    req = upright_request(cfg, model)
+    seen = perceive(
+        OmegaConf.to_object(cfg), model, req.object_pose, req.table_z, trial_seed(cfg, name, UPRIGHT_TRIAL)
+    )
+    return dataclasses.replace(req, observation=seen.observation)
+
+
+def time_plans(req: PlanRequest, runs: int) -> dict[str, np.ndarray]:
+    """Per run (``runs``,) seconds: ``wall`` and ``cpu`` (process time) of the whole plan, and the
+    planner's own ``fuse_cpu_s`` and ``infer_cpu_s``; NaN rows where it found no grasp."""
+    out = {k: np.full(runs, np.nan) for k in ("wall", "cpu", "fuse_cpu_s", "infer_cpu_s")}
+    for i in range(runs):
+        w0, c0 = time.perf_counter(), time.process_time()
+        try:
+            extras = plan(req).grasp.extras
+        except NoFeasibleGrasp:
+            extras = {}
+        out["cpu"][i], out["wall"][i] = time.process_time() - c0, time.perf_counter() - w0
+        out["fuse_cpu_s"][i] = extras.get("fuse_cpu_s", np.nan)
+        out["infer_cpu_s"][i] = extras.get("infer_cpu_s", np.nan)
+    return out
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = tool_parser(PROG, __doc__.split("\n")[0], overrides=True)
+    parser.add_argument("--runs", type=int, default=10, help="timed plans per object")
+    args = parser.parse_intermixed_args(argv)
+    given = {o.split("=")[0] for o in args.overrides}
+    cfg = compose_checked([d for d in DEFAULTS if d.split("=")[0] not in given] + args.overrides, PROG)
+    names = list(cfg.objects or cfg.dataset.objects)
+    try:
+        requests = [(name, observed_request(cfg, name)) for name in names]
+    except DatasetError as err:
+        fail(str(err), PROG)
+    w0, c0 = time.perf_counter(), time.process_time()
+    try:
+        plan(requests[0][1])
+    except NoFeasibleGrasp:
+        pass
+    first_wall, first_cpu = time.perf_counter() - w0, time.process_time() - c0
+    views = len(requests[0][1].observation.views)
+    print(
+        f"{PROG}: planner={cfg.planner.name}, gripper={cfg.gripper.name}, mode={cfg.mode.name}, camera "
+        f"{cfg.perception.camera.name} ({views} view(s), {cfg.perception.camera.width_px} x "
+        f"{cfg.perception.camera.height_px} px), planner.threads={cfg.planner.threads}, {args.runs} plans per "
+        f"object\nfirst plan of this process (imports, checkpoint hash and load): {first_wall:.2f} s wall, "
+        f"{first_cpu:.2f} s CPU"
+    )
+    print(
+        f"{'object':<26}{'wall p50':>9}{'wall p95':>9}{'CPU p50':>9}{'CPU p95':>9}{'fuse':>7}{'infer':>7}  ms"
+    )
+    p50s = []
+    for name, req in requests:
+        t = time_plans(req, args.runs)
+        ms = {k: np.nanpercentile(v, [50, 95]) * 1e3 for k, v in t.items()}
+        p50s.append([ms["wall"][0], ms["cpu"][0], ms["infer_cpu_s"][0]])
+        print(
+            f"{name:<26}{ms['wall'][0]:>9.0f}{ms['wall'][1]:>9.0f}{ms['cpu'][0]:>9.0f}{ms['cpu'][1]:>9.0f}"
+            f"{ms['fuse_cpu_s'][0]:>7.0f}{ms['infer_cpu_s'][0]:>7.0f}"
+        )
+    wall, cpu, infer = np.median(np.asarray(p50s), axis=0)
+    print(
+        f"median over objects of the p50: wall {wall:.0f} ms, CPU {cpu:.0f} ms (forward pass {infer:.0f} ms CPU)"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

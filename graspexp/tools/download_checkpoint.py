@@ -1,0 +1,51 @@
+"""Fetch a published network checkpoint and verify its SHA-256.
+
+Usage::
+
+    python -m graspexp download_checkpoint vgn [--dir DIR] [--url URL]
+
+The file lands in ``DIR``, else ``$GRASPEXP_CHECKPOINTS``, else ``~/.cache/graspexp/checkpoints`` (where the
+learned planners look for it, :mod:`graspexp.core.checkpoints`). It comes from its published address (a
+fixed commit of the authors' repository; ``--url`` for a mirror) through the project's downloader (pooch)
+and is kept only if its SHA-256 is the published one; a file already there with that hash is not fetched
+again.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from graspexp.core.checkpoints import CHECKPOINTS, CHECKPOINTS_ENV, checkpoint_dir
+from graspexp.datasets.download import fetch
+from graspexp.datasets.errors import DatasetError
+from graspexp.tools.cli import tool_parser
+
+PROG = "graspexp download_checkpoint"
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """CLI entry point; returns the exit status (2 with one line on stderr when the download fails)."""
+    parser = tool_parser(PROG, "Download and verify a published network checkpoint.")
+    parser.add_argument("name", choices=sorted(CHECKPOINTS), help="which checkpoint")
+    parser.add_argument("--dir", type=Path, default=None, help=f"target folder (default: ${CHECKPOINTS_ENV})")
+    parser.add_argument("--url", default=None, help="address of the file (a mirror; default: published)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    args = parser.parse_args(argv)
+    ckpt = CHECKPOINTS[args.name]
+    folder = (args.dir or checkpoint_dir()).expanduser()
+    try:
+        path = fetch(args.url or ckpt.url, folder, ckpt.filename, ckpt.sha256, progress=not args.quiet)
+    except DatasetError as err:
+        print(f"{PROG}: error: {err}", file=sys.stderr)
+        return 2
+    print(f"{ckpt.filename} ready at {path} (SHA-256 {ckpt.sha256} verified)")
+    print(f"weights: {ckpt.source}; licence: {ckpt.licence}")
+    if args.dir is not None and folder.resolve() != checkpoint_dir().resolve():
+        print(f"use it with {CHECKPOINTS_ENV}={folder}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
