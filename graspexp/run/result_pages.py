@@ -163,8 +163,8 @@ PAGES: tuple[Page, ...] = (
         "docs/results/generalisation.md",
         GENERALISATION,
         readings_tables(GENERALISATION),
-        GENERALISATION,
-        ("objects=[024_bowl,003_cracker_box]", "trials=1"),
+        _sweeps([s.reading.name for s in GENERALISATION], ("dataset=ycb",)),
+        ("objects=[024_bowl,003_cracker_box]", "trials=1"),  # two objects of the test split
     ),
     Page(
         "ablation",

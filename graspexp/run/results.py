@@ -80,8 +80,8 @@ class Sweep:
 @dataclass(frozen=True)
 class PageInput:
     """What a page's ``render`` gets: each sweep's directory, a folder for the page's figures (beside the
-    page, ``<page>_files/``, linked as such; the render makes it when it draws) and a work folder for its
-    CSV files (under OUT)."""
+    page, ``<page>_files/``, linked as such; emptied before each render, which makes it when it draws)
+    and a work folder for its CSV files (under OUT)."""
 
     runs: Mapping[Sweep, Path]
     assets: Path
@@ -321,6 +321,7 @@ def regenerate(
             page.admonition,
         )
         work.mkdir(parents=True, exist_ok=True)
+        shutil.rmtree(assets, ignore_errors=True)  # every file in it is drawn again: none outlives its page
         body = page.render(PageInput({s: out / "runs" / s.name for s in page.sweeps}, assets, work))
         path.write_text(replace_block(path.read_text(), head + "\n" + body, str(path)))
         print(f"graspexp results: wrote {path}", file=sys.stderr)

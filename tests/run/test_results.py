@@ -9,6 +9,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from graspexp.config.compose import compose_validated
+from graspexp.datasets import select_objects
 from graspexp.report.pages import (
     BEGIN,
     END,
@@ -87,6 +89,14 @@ def test_overrides_merge_last_wins_and_pages_are_well_formed():
     for page in PAGES:
         for s in page.sweeps:
             assert names.setdefault(s.name, s) == s, f"two sweeps named {s.name}"
+
+
+@pytest.mark.slow
+def test_every_fingerprint_job_composes_and_names_its_objects():
+    jobs = {tuple(sorted(j)): j for page in PAGES for j in fingerprint_jobs(page)}
+    for job in jobs.values():
+        cfg = compose_validated(list(job))
+        assert select_objects(cfg.dataset, cfg.objects), job
 
 
 def test_an_unknown_page_is_refused_with_one_line(capsys):
