@@ -58,14 +58,14 @@ def test_job_writes_one_log_per_trial_and_a_results_table(two_runs):
 
 
 def test_log_reads_back_with_expected_topics_and_schemas(two_runs):
-    log = read_trial(two_runs[0] / "trials" / "can" / "000.mcap")
+    log = read_trial(two_runs[0] / "trials" / "box" / "000.mcap")
     assert log.topics["/tf"] == "foxglove.FrameTransforms"
     assert log.topics["/scene"] == "foxglove.SceneUpdate"
     assert log.topics["/contacts"] == "foxglove.PointCloud"
     assert log.topics["/grasp"] == "graspexp.PlannedGrasp@1"
     assert log.topics["/result"] == "graspexp.TrialResult@4"
     assert {"object", "palm", "finger_left", "finger_right"} <= set(log.transforms)
-    assert log.metadata["object"] == "can" and "config_yaml" in log.metadata
+    assert log.metadata["object"] == "box" and "config_yaml" in log.metadata
     times, _, _ = log.transforms["object"]
     assert times[-1] == pytest.approx(log.result["sim_time_s"], abs=0.05)
 
@@ -77,7 +77,7 @@ def test_same_seed_gives_identical_mcap_payloads(two_runs):
 
 
 def test_replay_prints_timeline_and_resim_agrees(two_runs):
-    path = two_runs[0] / "trials" / "can" / "000.mcap"
+    path = two_runs[0] / "trials" / "box" / "000.mcap"
     proc = graspexp("replay", str(path), "--resim", timeout=120)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     assert "approach" in proc.stdout and "reproduced" in proc.stdout

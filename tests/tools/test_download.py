@@ -22,6 +22,7 @@ import trimesh
 
 from graspexp.config import DatasetConfig
 from graspexp.datasets import DatasetError, download, load_object
+from graspexp.datasets.ycb_objects import GOOGLE_16K_EXTENTS_MM
 from graspexp.tools import download as download_tool
 
 YCB_ID = "061_foam_brick"
@@ -32,10 +33,12 @@ def cube_bytes(size: float, file_type: str) -> bytes:
     return data.encode() if isinstance(data, str) else data
 
 
-def google_16k_bytes(size: float) -> bytes:
-    """An OBJ of a cylinder ``size`` across with the 16,384 faces every google_16k model has."""
-    can = trimesh.creation.cylinder(radius=size / 2, height=size, sections=4096)
+def google_16k_bytes(scale: float) -> bytes:
+    """An OBJ with the 16,384 faces every google_16k model has: a cylinder stretched to the foam brick's
+    published extents (mm, ``GOOGLE_16K_EXTENTS_MM``) times ``scale``, in metres."""
+    can = trimesh.creation.cylinder(radius=0.5, height=1.0, sections=4096)
     assert len(can.faces) == 16384
+    can.apply_scale(np.asarray(GOOGLE_16K_EXTENTS_MM[YCB_ID]) * scale / 1000.0)
     return can.export(file_type="obj").encode()
 
 
@@ -86,12 +89,12 @@ def server(tmp_path, monkeypatch):
         thread.join(timeout=5)
 
 
-def ycb_archive(folder: Path, size: float = 0.05) -> Path:
+def ycb_archive(folder: Path, scale: float = 1.0) -> Path:
     path = folder / f"{YCB_ID}_google_16k.tgz"
     write_tgz(
         path,
         {
-            f"{YCB_ID}/google_16k/textured.obj": google_16k_bytes(size),
+            f"{YCB_ID}/google_16k/textured.obj": google_16k_bytes(scale),
             f"{YCB_ID}/google_16k/textured.mtl": b"newmtl material_0\n",
         },
     )
@@ -128,7 +131,7 @@ def test_ycb_download_records_hash_and_loads(server, tmp_path, capsys):
     assert "recorded SHA-256" in capsys.readouterr().out
 
     obj = load_object(DatasetConfig(name="ycb", root=str(root), regions="ycb.yaml"), YCB_ID, 256, 0)
-    np.testing.assert_allclose(obj.mesh.extents, 0.05)
+    np.testing.assert_allclose(obj.mesh.extents, np.asarray(GOOGLE_16K_EXTENTS_MM[YCB_ID]) / 1000.0)
     assert obj.mass_kg == pytest.approx(0.028) and obj.area_mask.any()
 
     # A re-run finds the verified archive and downloads nothing.
@@ -145,7 +148,7 @@ def test_ycb_tampered_archive_fails_clearly(server, tmp_path, capsys):
     mesh = root / "ycb" / YCB_ID / "google_16k" / "textured.obj"
     original = mesh.read_bytes()
 
-    ycb_archive(folder, size=0.07)  # the server now serves different bytes under the same name
+    ycb_archive(folder, scale=1.001)  # the server now serves different bytes under the same name
     (root / download.ARCHIVE_DIR / f"{YCB_ID}_google_16k.tgz").unlink()  # e.g. a fresh machine, same root
     argv = ["dataset=ycb", f"dataset.root={root}", f"objects=[{YCB_ID}]", "--base-url", url, "progress=false"]
     assert download_tool.main(argv) == 2
