@@ -49,9 +49,15 @@ OUTCOME_COLUMNS: tuple[str, ...] = (
     "sim_time_s",
     "steps",
     "at_rest",
+    "pose_trans_err_mm",
+    "pose_rot_err_deg",
+    "pose_adds_mm",
+    "registration_fitness",
 )
-"""The results.csv columns a fingerprint hashes: every trial outcome, not the wall-clock timings (which
-differ between runs of one config) nor a column added later (a new result field alone moves no number)."""
+"""The results.csv columns a fingerprint hashes: every trial outcome (:class:`graspexp.core.outcome.TrialResult`),
+not the time measurements (``timings_s``, ``registration_cpu_s``: they differ between runs of one config) nor
+``error`` (a message's wording). Kept as a list rather than derived from the fields, so that a result field
+added later (with no number moved) does not turn every page stale; a test checks that each name is a field."""
 
 
 class PageError(ValueError):

@@ -10,10 +10,13 @@ import pandas as pd
 import pytest
 
 from graspexp.config.compose import compose_validated
+from graspexp.core.outcome import TrialResult
 from graspexp.datasets import select_objects
 from graspexp.report.pages import (
     BEGIN,
     END,
+    OUTCOME_COLUMNS,
+    OUTCOME_KEYS,
     PageError,
     Stamp,
     outcome_fingerprint,
@@ -62,8 +65,15 @@ def test_a_fingerprint_hashes_outcomes_not_timings_nor_new_columns():
     assert outcome_fingerprint([_results(new_field="x")]) == base
     assert outcome_fingerprint([_results(grasp_cost="1.2500000001")]) != base
     assert outcome_fingerprint([_results(success="False")]) != base
+    assert outcome_fingerprint([_results(registration_cpu_s="0.02")]) == base
+    assert outcome_fingerprint([_results(pose_adds_mm="3.5")]) != base
     two = [_results(), _results(trial="1")]
     assert outcome_fingerprint(two) == outcome_fingerprint(two[::-1])
+
+
+def test_every_fingerprinted_column_is_a_result_field():
+    fields = set(TrialResult.__dataclass_fields__)
+    assert set(OUTCOME_KEYS + OUTCOME_COLUMNS) <= fields
 
 
 def test_the_block_is_replaced_and_its_stamp_read_back(tmp_path: Path):
