@@ -55,6 +55,7 @@ def write_cube_obj(path: Path, size_m: float = 0.05) -> Path:
 # --- real meshes -------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_every_shared_object_loads_in_metres(data_root, manifest):
     pairs = shared_objects(data_root)
     assert len(pairs) == 23 + 9  # SOURCES.md: 23 YCB meshes, 9 of 13 LINEMOD meshes

@@ -4,6 +4,7 @@ decomposition (real SAPIEN physics)."""
 
 import numpy as np
 import pandas as pd
+import pytest
 import trimesh
 from helpers.cli import graspexp
 from helpers.config import REPO
@@ -14,6 +15,7 @@ from graspexp.record.reader import read_metadata
 NAMES = ["arc", "ball", "box", "bracket", "can", "cone"]
 
 
+@pytest.mark.slow
 def test_a_folder_runs_both_modes_with_three_planners_and_reports(tmp_path):
     objects = make_object_folder(tmp_path / "objects")
     out = tmp_path / "bench"
@@ -42,6 +44,7 @@ def test_a_folder_runs_both_modes_with_three_planners_and_reports(tmp_path):
         assert rows == [*NAMES, "Average"]
 
 
+@pytest.mark.slow
 def test_an_unusable_object_fails_alone_and_an_unrepairable_mesh_falls_back(tmp_path):
     objects = tmp_path / "objects"
     objects.mkdir()

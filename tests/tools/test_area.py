@@ -135,6 +135,7 @@ def test_errors_are_one_line(args, message, capsys):
     assert err.startswith("graspexp area: error: ") and message in err and err.count("\n") == 1
 
 
+@pytest.mark.slow
 def test_module_alias_exits_2_without_a_traceback(tmp_path):
     proc = subprocess.run(
         [sys.executable, "-m", "graspexp.area", "dataset=primitives", "--object", "teapot"],

@@ -40,6 +40,7 @@ def _complete(script: str, word: str) -> list[str]:
     return done.stdout.split()
 
 
+@pytest.mark.slow
 def test_bash_completion_installs_and_completes_options_but_no_schema():
     script = _graspexp("--shell-completion", "install=bash")
     assert script.returncode == 0, script.stderr
@@ -84,6 +85,7 @@ def test_every_tool_has_its_own_help(tool, capsys):
     assert capsys.readouterr().out.startswith(f"usage: graspexp {tool} ")
 
 
+@pytest.mark.slow
 def test_tools_run_as_subcommands_and_are_listed_in_the_help():
     proc = _graspexp("compare", "--help")
     assert proc.returncode == 0 and proc.stdout.startswith("usage: graspexp compare "), proc.stderr

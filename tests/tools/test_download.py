@@ -215,6 +215,7 @@ def test_unsafe_archive_member_is_refused(server, tmp_path):
     assert not (tmp_path / "evil.txt").exists()
 
 
+@pytest.mark.slow
 def test_cli_arguments(monkeypatch, tmp_path):
     monkeypatch.setenv("GRASPEXP_DATA", str(tmp_path))
     args = download_tool.parse_args(["dataset=ycb", "objects=[025_mug, 011_banana]"])

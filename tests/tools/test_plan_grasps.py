@@ -1,10 +1,12 @@
 """bench.plan_grasps: the grasps planners choose on fixed seeded poses, saved and checked bit for bit."""
 
 import numpy as np
+import pytest
 
 from graspexp.tools.bench.plan_grasps import main
 
 
+@pytest.mark.slow
 def test_plan_grasps_finds_its_own_plans_identical_and_names_a_changed_one(tmp_path, capsys) -> None:
     saved = tmp_path / "grasps.npz"
     argv = ["--poses", "3", "dataset=primitives", "mode=collab", "objects=[can,mug]"]

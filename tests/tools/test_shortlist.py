@@ -2,6 +2,7 @@
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from graspexp.planning.optimal_plus import pick_shortlisted
 from graspexp.tools.bench.shortlist import main as shortlist_main
@@ -17,6 +18,7 @@ def test_pick_shortlisted_prefers_room_by_the_finger_edges_then_cost() -> None:
     assert pick_shortlisted("edge_clearance", costs, robust, clear) == 0  # ties at 0: the cost decides
 
 
+@pytest.mark.slow
 def test_shortlist_study_simulates_every_shortlisted_grasp(tmp_path, capsys) -> None:
     out = tmp_path / "shortlist.csv"
     argv = ["--out", str(out), "trials=1", "dataset=primitives", "objects=[can]"]

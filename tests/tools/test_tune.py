@@ -158,6 +158,7 @@ def test_a_study_that_cannot_start_is_one_line_and_leaves_nothing(tmp_path: Path
     assert not out.exists()  # no optuna.db, no lock left behind
 
 
+@pytest.mark.slow
 def test_a_damaged_study_database_is_one_line(tmp_path: Path) -> None:
     out = tmp_path / "sweep"
     out.mkdir()
@@ -169,6 +170,7 @@ def test_a_damaged_study_database_is_one_line(tmp_path: Path) -> None:
     assert not list(out.glob("*/results.csv"))  # no trial ran
 
 
+@pytest.mark.slow
 def test_a_study_resumed_on_another_data_root_is_refused(tmp_path: Path) -> None:
     from graspexp.report.study import write_study_record
 
