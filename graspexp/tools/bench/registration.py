@@ -12,8 +12,9 @@ Each object at ``--poses`` seeded random orientations on the support, seen by ``
 (Gaussian std ``--prior-mm`` / ``--prior-deg``), or global registration with
 ``perception.registration.prior=none``. Per object: median ADD-S, the share of registrations under 1 cm
 ADD-S (the usual YCB-Video threshold), median translation and rotation errors and fitness. Then over every
-registration: p50 and p95 of the depth frame (ray cast, noise, cloud, normals), of the registration and of
-both, CPU time of the process (all threads) beside wall time, ms, against the target of p50 <= 40 ms CPU.
+registration: p50 and p95 of the depth frame (ray cast, noise, cloud, the target's normals), of the
+registration and of both, CPU time of the process (all threads) beside wall time, ms, against the target
+of p50 <= 40 ms CPU.
 BLAS/OpenMP run on one thread (``OMP_NUM_THREADS=1`` set before numpy loads, and threadpoolctl).
 """
 
