@@ -228,3 +228,10 @@ def test_a_page_whose_planner_cannot_run_here_is_skipped_with_one_line(monkeypat
         for line in err
     )
     assert err[0].startswith("graspexp results: page camera (docs/results/camera.md) skipped: planner=vgn")
+
+
+def test_every_results_page_is_generated_but_the_labelled_experiments():
+    """Every page under docs/results/ is a :data:`PAGES` entry (``python -m graspexp results`` rewrites
+    it), but the experiments page (before/after studies, each naming its commits)."""
+    pages = {str(p.relative_to(ROOT)) for p in (ROOT / "docs" / "results").rglob("*.md")}
+    assert pages - {p.path for p in PAGES} == {"docs/results/experiments.md"}
