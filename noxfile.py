@@ -15,6 +15,8 @@ nox.options.reuse_existing_virtualenvs = True
 HERE = Path(__file__).parent
 DATA = os.environ.get("GRASPEXP_DATA", str((HERE / ".." / "shared" / "datasets").resolve()))
 ENV = {"GRASPEXP_DATA": DATA, "OMP_NUM_THREADS": "1"}
+LEARNED_PAGES = ("camera", "learned")
+"""The results pages whose sweeps run a learned planner (``planner=vgn``): ``nox -s learned`` checks them."""
 CHECKPOINTS = os.environ.get("GRASPEXP_CHECKPOINTS", str((Path(DATA) / ".." / "peers" / "vgn").resolve()))
 """The published checkpoints the learned planners' tests read (``../shared/peers/vgn``; never copied)."""
 
@@ -44,13 +46,15 @@ def _install_learned(session: nox.Session) -> bool:
 @nox.session
 def learned(session: nox.Session) -> None:
     """The learned planners' tests (``-m learned``: planner=vgn loads its checkpoint, gives the same outputs
-    every time, plans on a rendered scene) with the optional extra ``learned`` installed; skipped with one
-    line where the extra cannot be installed."""
+    every time, plans on a rendered scene) with the optional extra ``learned`` installed, then the
+    fingerprints of the results pages that run them (``results --check --pages camera,learned``: skipped by
+    the check without the extra); skipped with one line where the extra cannot be installed."""
     session.install("-e", ".[test]", "-c", "constraints.txt")
     if not _install_learned(session):
         session.skip("nox -s learned skipped: the optional extra learned is not available on this machine")
     env = {**ENV, "GRASPEXP_CHECKPOINTS": CHECKPOINTS}
     session.run("pytest", "-m", "learned", "-p", "no:cacheprovider", *session.posargs, env=env)
+    session.run("python", "-m", "graspexp", "results", "--check", "--pages", ",".join(LEARNED_PAGES), env=env)
 
 
 @nox.session

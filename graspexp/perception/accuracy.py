@@ -22,7 +22,8 @@ SUPPORT_HALF_M = 0.15
 @dataclass(frozen=True)
 class Attempt:
     """One registration: its errors (mm, deg, ADD-S mm), fitness, and per step the CPU time of this process
-    (all threads) and the wall time, s: ``depth`` (render, noise, cloud, normals), ``registration``."""
+    (all threads) and the wall time, s: ``depth`` (render, noise, cloud, the target's normals),
+    ``registration``."""
 
     trans_mm: float
     rot_deg: float
@@ -74,6 +75,7 @@ def registration_attempts(
             1,
             rng=rng_for(seed, model.name, i, "camera"),
         )
+        obs.target()  # the normals registration reads (estimated once, kept by the observation)
         c1, w1 = time.process_time(), time.perf_counter()
         prior = None
         if cfg.registration.prior != "none":

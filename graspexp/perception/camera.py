@@ -3,15 +3,19 @@ angles of the scene's actual geometry (the posed object meshes and the axis-alig
 
 Why a ray caster: SAPIEN's camera needs a Vulkan device, which these CPU-only machines lack (Debian 12's
 Mesa lavapipe is too old for SAPIEN 3's renderer); Embree (Intel's ray tracing kernels, through the
-``embreex`` package and trimesh's ``RayMeshIntersector``) runs everywhere. Where a GPU with Vulkan exists
-SAPIEN's renderer could be used instead; this module does not need one.
+``embreex`` package's scene API) runs everywhere. Where a GPU with Vulkan exists SAPIEN's renderer could
+be used instead; this module does not need one.
 
 Only the rays inside a mesh's projected bounding box are cast at it (in the mesh's own frame, so its
 Embree BVH is built once per mesh, not per trial); the support boxes are intersected analytically (slab
 test). Both are exact: a ray outside the projection of a body's bounding box cannot meet the body.
+Embree (single precision) finds the triangle each ray meets first; the hit point is that triangle's plane
+met in double precision (:func:`first_hits`, the numbers trimesh's ``RayMeshIntersector`` gives, without
+its bookkeeping for multiple hits).
 """
 
 import functools
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -110,6 +114,73 @@ def _require_embree() -> None:
         raise ImportError(f"the depth camera needs embreex, not installed: {CAMERA_EXTRA}") from None
 
 
+@dataclass(frozen=True)
+class _Bvh:
+    """What the ray caster keeps of a mesh (its own frame): the Embree scene, built on the vertices
+    shifted by ``origin`` and scaled by ``scale`` to a box of about 100 units (single precision keeps
+    about 1e-5 of that: micrometres on a 10 cm object); each triangle's first vertex (F, 3) and unit
+    normal (F, 3), m; the corners (8, 3) of the bounding box, m. Copies, read without trimesh's cache
+    checks (each hashes the mesh: milliseconds per frame)."""
+
+    mesh: "weakref.ref[trimesh.Trimesh]"
+    scene: object
+    origin: np.ndarray
+    scale: float
+    plane_origins: np.ndarray
+    face_normals: np.ndarray
+    corners: np.ndarray
+
+
+_BVHS: dict[int, _Bvh] = {}
+"""Each mesh's :class:`_Bvh` by ``id``, built at its first frame, dropped with the mesh."""
+
+
+def _bvh(mesh: trimesh.Trimesh) -> _Bvh:
+    bvh = _BVHS.get(id(mesh))
+    if bvh is None or bvh.mesh() is not mesh:
+        from embreex import mesh_construction, rtcore_scene
+
+        vertices = np.asarray(mesh.vertices, dtype=np.float64)
+        faces = np.asarray(mesh.faces)
+        origin, scale = vertices.min(axis=0), 100.0 / float(mesh.scale)
+        scene = rtcore_scene.EmbreeScene()
+        mesh_construction.TriangleMesh(
+            scene=scene,
+            vertices=((vertices - origin) * scale).astype(np.float32),
+            indices=faces.astype(np.int32),
+        )
+        key = id(mesh)
+        bvh = _BVHS[key] = _Bvh(
+            weakref.ref(mesh, lambda _: _BVHS.pop(key, None)),
+            scene,
+            origin,
+            scale,
+            vertices[faces[:, 0]],
+            np.array(mesh.face_normals, dtype=np.float64),
+            trimesh.bounds.corners(mesh.bounds),
+        )
+    return bvh
+
+
+def first_hits(
+    mesh: trimesh.Trimesh, origin: np.ndarray, dirs: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The first hit of each ray ``origin + t dirs`` (origin (3,), dirs (R, 3), the mesh's frame, m) on
+    ``mesh``: (index_ray (H,) of the rays that hit, ascending; index_tri (H,) the triangle each meets;
+    locations (H, 3) the hit points, m). Rays within 1e-5 of parallel to their triangle's plane count as
+    misses."""
+    bvh = _bvh(mesh)
+    unit = trimesh.util.unitize(np.asarray(dirs, dtype=np.float64))
+    origins = np.repeat(np.asarray(origin, dtype=np.float64)[None, :], len(unit), axis=0)
+    tri = bvh.scene.run(((origins - bvh.origin) * bvh.scale).astype(np.float32), unit.astype(np.float32))
+    ray = np.flatnonzero(tri != -1)
+    tri = tri[ray].astype(np.int64)
+    locations, valid = trimesh.intersections.planes_lines(
+        bvh.plane_origins[tri], bvh.face_normals[tri], origins[ray], unit[ray]
+    )
+    return ray[valid], tri[valid], locations
+
+
 def _box_hits(origin: np.ndarray, dirs: np.ndarray, box: BoxBody) -> tuple[np.ndarray, np.ndarray]:
     """Rays ``origin + t dirs`` (dirs (R, 3)) against an axis-aligned box seen from outside: each ray
     enters through one of the (at most 3) faces turned towards ``origin``. Returns (t (R,), inf where
@@ -133,7 +204,7 @@ def _box_hits(origin: np.ndarray, dirs: np.ndarray, box: BoxBody) -> tuple[np.nd
 def _mesh_rect(body: MeshBody, camera_from_world: np.ndarray, cam: CameraConfig) -> tuple[int, int, int, int]:
     """Pixel rectangle (u0, u1, v0, v1), half-open, covering the projection of the mesh's bounding box;
     the whole image if a corner is behind the camera."""
-    corners = trimesh.bounds.corners(body.mesh.bounds)
+    corners = _bvh(body.mesh).corners
     world = corners @ body.pose[:3, :3].T + body.pose[:3, 3]
     c = world @ camera_from_world[:3, :3].T + camera_from_world[:3, 3]
     if (c[:, 2] <= 1e-6).any():
@@ -176,9 +247,7 @@ def render(
         Rb, tb = body.pose[:3, :3], body.pose[:3, 3]
         origin_b = (eye - tb) @ Rb  # the rays in the mesh's frame
         dirs_b = dirs[pix] @ Rb
-        locations, index_ray, index_tri = body.mesh.ray.intersects_location(
-            np.repeat(origin_b[None, :], len(dirs_b), axis=0), dirs_b, multiple_hits=False
-        )
+        index_ray, index_tri, locations = first_hits(body.mesh, origin_b, dirs_b)
         if len(index_ray) == 0:
             continue
         d = dirs_b[index_ray]
@@ -187,7 +256,7 @@ def render(
         closer = (t > 0) & (t < best[p])
         p, t = p[closer], t[closer]
         best[p], ids[p] = t, body.body_id
-        n = body.mesh.face_normals[index_tri[closer]]
+        n = _bvh(body.mesh).face_normals[index_tri[closer]]
         cos[p] = np.abs(np.einsum("ij,ij->i", n, d[closer]) / np.linalg.norm(d[closer], axis=1))
     valid = np.isfinite(best) & (best >= cam.min_range_m) & (best <= cam.max_range_m)
     depth = np.where(valid, best, 0.0)

@@ -60,8 +60,10 @@ def noisy_depth(
     ids = np.asarray(ids).ravel()[src].reshape(h, w)
     theta = theta.ravel()[src].reshape(h, w)
 
-    noise = rng.standard_normal((h, w), dtype=np.float32) * axial_sigma_m(cfg, depth, theta)
-    out = np.where(depth > 0, depth + noise, 0.0)
+    draw = rng.standard_normal((h, w), dtype=np.float32)
+    out = np.zeros((h, w))
+    ret = depth > 0
+    out[ret] = depth[ret] + draw[ret] * axial_sigma_m(cfg, depth[ret], theta[ret])
 
     edge = np.zeros((h, w), dtype=bool)
     for a, b in ((out[1:, :], out[:-1, :]), (out[:, 1:], out[:, :-1])):

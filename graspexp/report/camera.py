@@ -1,14 +1,15 @@
 """Table 1 with the camera in the loop: the paper's objects and settings, the same drops for every column
-(the drops derive from the trial seed, not the planner), five measured columns beside the paper's printed
-ones. Read from the ``results.csv`` files (or logs) of a sweep below one folder
-(:func:`graspexp.report.collect.collect`).
+(the drops derive from the trial seed, not the planner), the measured columns beside the paper's printed
+ones. Read from the ``results.csv`` files (or logs) of sweeps (:func:`graspexp.report.collect.collect`).
 
-Columns: ``optimal`` with the exact pose (``perception.source=truth``, no pose noise), ``optimal`` and
-``optimal_plus`` with the registered pose (``perception.source=depth`` from a prior: :func:`_registered`),
-``antipodal`` on the full model, ``antipodal_view`` on the camera's cloud only; then the paper's GPD,
-PointNetGPD 2-class and 3-class (other papers' real robots, copied) and its own column for the setting.
+Columns (:data:`COLUMNS`): ``optimal`` with the exact pose (``perception.source=truth``, no pose noise),
+``optimal`` and ``optimal_plus`` with the registered pose (``perception.source=depth`` from a prior:
+:func:`_registered`), ``antipodal`` on the full model, ``antipodal_view`` on the camera's cloud only, and
+the learned ``vgn`` on the camera's views (:data:`LEARNED_COLUMNS`); then the paper's GPD, PointNetGPD
+2-class and 3-class (other papers' real robots, copied) and its own column for the setting.
 """
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +29,10 @@ COLUMNS = (
     ("antipodal_view", False, "antipodal_view, camera cloud"),
 )
 """(planner, registered pose, column label) of the measured columns."""
+LEARNED_COLUMNS = (("vgn", False, "vgn, gripper=panda, camera views"),)
+"""The learned planners' columns. ``results.csv`` does not record the gripper: the label states how the
+results page runs them (``gripper=panda``, the gripper VGN was trained for)."""
+Column = tuple[str, bool, str]
 
 
 def _cell(g: pd.DataFrame) -> str:
@@ -46,9 +51,11 @@ def _registered(df: pd.DataFrame) -> pd.Series:
     return np.isfinite(adds) | prior
 
 
-def setting_table(results: pd.DataFrame, mode: str, rot: str) -> pd.DataFrame:
+def setting_table(
+    results: pd.DataFrame, mode: str, rot: str, columns: Sequence[Column] = COLUMNS
+) -> pd.DataFrame:
     """Success % per Table 1 object (rows, the paper's order, and an Average row with the Wilson 95 %
-    interval over all its trials) and column, for one setting."""
+    interval over all its trials) and column of ``columns``, for one setting."""
     df = results[(results["mode"] == mode) & (results["rot"] == rot)]
     registered = _registered(df)
     setting = SETTINGS.index((mode, rot))
@@ -57,7 +64,7 @@ def setting_table(results: pd.DataFrame, mode: str, rot: str) -> pd.DataFrame:
         row = {"object": label}
         on = df if obj == "" else df[df["object"] == obj]
         reg = registered if obj == "" else registered[df["object"] == obj]
-        for planner, is_reg, col in COLUMNS:
+        for planner, is_reg, col in columns:
             g = on[(on["planner"] == planner) & (reg == is_reg)]
             row[col] = _cell(g) if obj else _cell(g) + f" n={len(g)}"
         base = TABLE1.baselines_average if obj == "" else TABLE1.baselines[obj]
@@ -89,17 +96,35 @@ def pose_summary(results: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def camera_comparison(root: Path | str) -> str:
-    """The Markdown of the comparison (one table per setting found below ``root``, the pose errors, and
-    success against the measured pose error)."""
-    results = collect(root).results
-    md = []
+def pooled_table(results: pd.DataFrame, columns: Sequence[Column] = COLUMNS) -> pd.DataFrame:
+    """Per column of ``columns`` (rows): success % over every Table 1 trial of the four settings, its Wilson
+    95 % interval and the trial count."""
+    df = results[results["object"].isin(list(TABLE1.labels))]
+    registered = _registered(df)
+    rows = []
+    for planner, is_reg, col in columns:
+        g = df[(df["planner"] == planner) & (registered == is_reg)]
+        rate, lo, hi = success_pct(int(g["success"].sum()), len(g))
+        rows.append({"column": col, "trials": len(g), "success %": f"{rate:.1f} ({lo:.1f}-{hi:.1f})"})
+    return pd.DataFrame(rows)
+
+
+def camera_markdown(results: pd.DataFrame, columns: Sequence[Column] = COLUMNS) -> str:
+    """The Markdown of the comparison of ``results`` (Table 1's YCB trials of every column): the pooled
+    success per column, one table per setting found, the registered pose errors and success against the
+    measured pose error."""
+    md = [
+        "### Pooled over the four settings",
+        "",
+        markdown(pooled_table(results, columns), index=False),
+        "",
+    ]
     for mode, rot in SETTINGS:
         if ((results["mode"] == mode) & (results["rot"] == rot)).any():
             md += [
                 f"### {SETTING_LABELS[(mode, rot)]}",
                 "",
-                markdown(setting_table(results, mode, rot), index=False),
+                markdown(setting_table(results, mode, rot, columns), index=False),
                 "",
             ]
     summary = pose_summary(results)
@@ -117,3 +142,8 @@ def camera_comparison(root: Path | str) -> str:
             "",
         ]
     return "\n".join(md)
+
+
+def camera_comparison(root: Path | str, columns: Sequence[Column] = COLUMNS) -> str:
+    """:func:`camera_markdown` of every trial below ``root``."""
+    return camera_markdown(collect(root).results, columns)

@@ -6,15 +6,21 @@ more entry here (and a page file holding the generated block's two marker lines,
 
 from __future__ import annotations
 
+import shlex
+import subprocess
+import sys
 from collections.abc import Callable, Sequence
 
 from graspexp.report.build import agreement_section, build_report
+from graspexp.report.camera import COLUMNS, LEARNED_COLUMNS, camera_markdown
+from graspexp.report.collect import collect
 from graspexp.report.gallery import write_gallery
+from graspexp.report.learned import learned_markdown
 from graspexp.report.pages import embed
 from graspexp.report.readings import beside_paper, reading_averages, readings_report
 from graspexp.report.study import plot_study, read_sweep_study, study_table
 from graspexp.report.tuning import scored_trial, tuning_markdown
-from graspexp.run.results import Page, PageInput, Sweep
+from graspexp.run.results import Page, PageInput, ResultsError, Sweep
 from graspexp.run.score import score_study
 from graspexp.run.suites import ABLATIONS, ALL, READINGS, Reading
 
@@ -110,6 +116,136 @@ def _readme(sweep: Sweep) -> Callable[[PageInput], str]:
     return render
 
 
+def _table1_trials(page: PageInput, sweep: Sweep):
+    """The Table 1 (YCB) trials of ``sweep``'s runs."""
+    results = collect(page.runs[sweep]).results
+    return results[results["dataset"] == "ycb"]
+
+
+def _camera(sweeps: Sequence[Sweep]) -> Callable[[PageInput], str]:
+    """Table 1 measured in one physics (:func:`graspexp.report.camera.camera_markdown`): every column's
+    trials, from ``sweeps``."""
+
+    def render(page: PageInput) -> str:
+        import pandas as pd
+
+        results = pd.concat([_table1_trials(page, s) for s in sweeps], ignore_index=True)
+        return camera_markdown(results, (*COLUMNS, *LEARNED_COLUMNS)) + "\n" + _registration(page)
+
+    return render
+
+
+REGISTRATION_POSES = 10
+"""Seeded random orientations per object of the registration measurement on the camera page."""
+
+
+def _registration(page: PageInput) -> str:
+    """The registration accuracy and cost of every Table 1 and Table 2 object
+    (:func:`graspexp.report.registration.registration_report`, as ``python -m graspexp bench.registration``
+    prints it), measured while the page is written."""
+    from omegaconf import OmegaConf
+    from threadpoolctl import threadpool_limits
+
+    from graspexp.config.compose import compose_config
+    from graspexp.datasets import available_objects, job_object
+    from graspexp.report.paper import PAPER_TABLES
+    from graspexp.report.registration import registration_report
+
+    models, cfg, absent = {}, None, []
+    for dataset, table in PAPER_TABLES.items():
+        cfg = OmegaConf.to_object(compose_config([f"dataset={dataset}", "perception.source=depth"]))
+        present = set(available_objects(cfg.dataset))
+        models[dataset] = [job_object(cfg, name) for name in table.labels if name in present]
+        absent += [f"{dataset} {name}" for name in table.labels if name not in present]
+    with threadpool_limits(limits=1):
+        text = registration_report(cfg.perception, models, REGISTRATION_POSES, int(cfg.seed), 10.0, 10.0)
+    missing = f" Not measured (no mesh in the data root): {', '.join(absent)}." if absent else ""
+    return "\n".join(
+        [
+            "### Registration accuracy and cost",
+            "",
+            "`python -m graspexp bench.registration` (with BLAS and Open3D on one thread), run while this page "
+            f"was written, on the machine above.{missing}",
+            "",
+            "```",
+            text,
+            "```",
+            "",
+        ]
+    )
+
+
+INFERENCE_RUNS = 10
+"""Timed plans per object of the inference-time measurement on the learned planners' page."""
+
+
+def _inference(page: PageInput) -> str:
+    """``python -m graspexp bench.learned`` (planner=vgn's CPU time per plan on Table 1's objects), run while
+    the page is written; its printout."""
+    command = [sys.executable, "-m", "graspexp", "bench.learned", "--runs", str(INFERENCE_RUNS)]
+    done = subprocess.run(command, capture_output=True, text=True, check=False)
+    if done.returncode != 0:
+        raise ResultsError(
+            f"{shlex.join(command[1:])} failed: {(done.stderr.strip() or '?').splitlines()[-1]}"
+        )
+    return "\n".join(
+        [
+            "### Inference time",
+            "",
+            f"`python -m graspexp bench.learned --runs {INFERENCE_RUNS}` (one torch thread), run while this page "
+            "was written, on the machine above:",
+            "",
+            "```",
+            done.stdout.strip(),
+            "```",
+            "",
+        ]
+    )
+
+
+def _learned(runs: dict[str, Sweep]) -> Callable[[PageInput], str]:
+    """A learned planner's tables (:func:`graspexp.report.learned.learned_markdown`), one run per label, and
+    its inference time (:func:`_inference`)."""
+    return lambda page: "\n".join(
+        [learned_markdown({label: _table1_trials(page, s) for label, s in runs.items()}), _inference(page)]
+    )
+
+
+CAMERA_COMMON = ("dataset=ycb", "record=false")
+"""Table 1's objects (10 trials, the paper's settings: :func:`graspexp.run.suites.reading_sweep`), no logs."""
+REGISTERED = ("perception.source=depth", "perception.noise.trans_mm=10", "perception.noise.rot_deg=10")
+"""The pose registered from the camera, ICP from a prior 10 mm / 10 deg (std) off the truth."""
+ANTIPODAL_VIEW = Sweep(
+    Reading(
+        "antipodal_view",
+        ("planner=antipodal_view", *CAMERA_COMMON),
+        "antipodal sampling on the camera's cloud",
+    )
+)
+REGISTERED_OPTIMAL = Sweep(
+    Reading(
+        "registered_optimal", ("planner=optimal", *REGISTERED, *CAMERA_COMMON), "optimal, registered pose"
+    )
+)
+REGISTERED_PLUS = Sweep(
+    Reading(
+        "registered_optimal_plus",
+        ("planner=optimal_plus", *REGISTERED, *CAMERA_COMMON),
+        "optimal_plus, registered pose",
+    )
+)
+VGN_PANDA = Sweep(
+    Reading(
+        "vgn_panda",
+        ("planner=vgn", "gripper=panda", *CAMERA_COMMON),
+        "vgn with the gripper it was trained for",
+    )
+)
+VGN_RG2 = Sweep(
+    Reading(
+        "vgn_rg2", ("planner=vgn", "gripper=rg2", *CAMERA_COMMON), "vgn on the paper's gripper (a transfer)"
+    )
+)
 DEFAULT = Sweep(ALL["default"])
 TABLES = _sweeps(["default", "in_area", "literal"])
 COMPARED = _sweeps(["optimal_plus", "default", "antipodal_area", "antipodal_area_pads", "antipodal", "obb"])
@@ -119,6 +255,9 @@ GENERALISATION = _sweeps(
     ("dataset=ycb", "dataset.split=test"),
 )
 ABLATION = tuple(Sweep(r, ("trials=5",)) for r in ABLATIONS)
+CAMERA = (DEFAULT, REGISTERED_OPTIMAL, REGISTERED_PLUS, Sweep(ALL["antipodal"]), ANTIPODAL_VIEW, VGN_PANDA)
+"""Table 1 in one physics: the exact-pose and full-model columns are the readings' own sweeps (the same
+drops; their Table 2 trials are left out), the camera's columns run on Table 1 alone."""
 STUDY_Z = Sweep(
     Reading(
         "tuning_bin_z", (*STUDY, "rot=z", "hydra.sweeper.n_trials=60"), "the constants' study, bin, rot z"
@@ -174,6 +313,20 @@ PAGES: tuple[Page, ...] = (
         tuple(
             Sweep(ALL[n], ("trials=5",)) for n in ("plus", "plus_choose_cost", "plus_noise", "default_noise")
         ),
+    ),
+    Page(
+        "camera",
+        "docs/results/camera.md",
+        CAMERA,
+        _camera(CAMERA),
+        (DEFAULT, Sweep(ALL["antipodal"]), REGISTERED_OPTIMAL, ANTIPODAL_VIEW, VGN_PANDA),
+    ),
+    Page(
+        "learned",
+        "docs/results/learned.md",
+        (VGN_PANDA, VGN_RG2),
+        _learned({"vgn, gripper=panda": VGN_PANDA, "vgn, gripper=rg2 (transfer)": VGN_RG2}),
+        (VGN_PANDA, VGN_RG2),
     ),
     Page("tuning", "docs/results/tuning.md", (STUDY_Z,), _tuning(STUDY_Z), (DEFAULT,)),
     Page("tuning_xyz", "docs/results/xyz/tuning.md", (STUDY_XYZ,), _tuning(STUDY_XYZ), (DEFAULT,)),

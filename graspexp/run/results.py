@@ -13,7 +13,9 @@ A :class:`Page` (registered in :data:`graspexp.run.result_pages.PAGES`) declares
 :func:`regenerate` runs every sweep not yet done into ``OUT/runs/<sweep>`` (a sweep two pages share runs
 once; an interrupted regeneration continues: each sweep resumes its own trials, and a finished sweep is
 marked and skipped), then the fingerprint jobs, then writes each page's block. :func:`check` re-runs the
-fingerprint jobs into a temporary folder and compares each page's stamp.
+fingerprint jobs into a temporary folder and compares each page's stamp. A page whose sweeps name a planner
+that cannot run here (``planner=vgn`` without the optional extra ``learned`` or its checkpoint:
+:func:`unavailable`) is skipped by both, with one line saying why.
 """
 
 from __future__ import annotations
@@ -143,6 +145,36 @@ def fingerprint_jobs(page: Page, overrides: Sequence[str] = ()) -> list[tuple[st
         for s in page.fingerprint
         for mode, rot in FINGERPRINT_SETTINGS
     ]
+
+
+def unavailable(page: Page) -> str:
+    """'' when every planner that ``page``'s sweeps and fingerprint jobs name can run here; else one line:
+    the first that cannot and why (its plugin's ``unavailable``, e.g. the optional extra to install)."""
+    from graspexp.config.plugins import get_plugin
+
+    for sweep in (*page.sweeps, *page.fingerprint):
+        for override in (*sweep.reading.overrides, *sweep.extra):
+            key, _, value = override.partition("=")
+            if key.lstrip("+~") != "planner":
+                continue
+            for name in value.split(","):
+                plugin = get_plugin(name).plugin
+                why = plugin.unavailable() if plugin.unavailable is not None else ""
+                if why:
+                    return f"page {page.name} ({page.path}) skipped: planner={name} cannot run here: {why}"
+    return ""
+
+
+def available(pages: Sequence[Page]) -> list[Page]:
+    """The pages of ``pages`` whose planners can run here; one line on stderr for each that cannot."""
+    out = []
+    for page in pages:
+        why = unavailable(page)
+        if why:
+            print(f"graspexp results: {why}", file=sys.stderr)
+        else:
+            out.append(page)
+    return out
 
 
 def _job_key(overrides: Sequence[str]) -> str:
@@ -279,7 +311,8 @@ def regenerate(
 ) -> list[str]:
     """Run the sweeps of ``pages`` (each once, resumable) into ``out/runs``, their fingerprints, and write
     each page's generated block into its file under ``root``; returns one line per sweep that failed (its
-    pages are then left as they were)."""
+    pages are then left as they were). A page whose planners cannot run here is skipped (:func:`available`)."""
+    pages = available(pages)
     commit, date = commit_of(root)
     machine = describe_machine()
     sweeps = list(dict.fromkeys(s for page in pages for s in page.sweeps))
@@ -292,7 +325,7 @@ def regenerate(
         users = ", ".join(p.name for p in pages if sweep in p.sweeps)
         times[sweep] = run_sweep(sweep, out / "runs", overrides, f"[{i}/{len(sweeps)}] ({users})", commit)
     failed = {s for s, t in times.items() if t.rc != 0}
-    fingerprints = run_fingerprints(pages, out / "fingerprint", n_jobs, overrides)
+    fingerprints = run_fingerprints(pages, out / "fingerprint", n_jobs, overrides) if pages else {}
     problems = [f"sweep {s.name} exited {times[s].rc}: {times[s].command}" for s in failed]
     for page in pages:
         if failed & set(page.sweeps):
@@ -349,7 +382,9 @@ def _fingerprint_trials(jobs: Sequence[Sequence[str]]) -> int:
 
 def check(pages: Sequence[Page], root: Path, n_jobs: int) -> list[str]:
     """One line per page of ``pages`` whose recorded fingerprint the current code does not reproduce (or
-    that records none); [] when every page is current."""
+    that records none); [] when every page is current. A page whose planners cannot run here is skipped
+    (:func:`available`)."""
+    pages = available(pages)
     recorded = {}
     problems = []
     for page in pages:
@@ -362,7 +397,8 @@ def check(pages: Sequence[Page], root: Path, n_jobs: int) -> list[str]:
         else:
             recorded[page.name] = stamp
     with tempfile.TemporaryDirectory(prefix="graspexp-results-check-") as tmp:
-        now = run_fingerprints([p for p in pages if p.name in recorded], Path(tmp), n_jobs)
+        stamped = [p for p in pages if p.name in recorded]
+        now = run_fingerprints(stamped, Path(tmp), n_jobs) if stamped else {}
     for page in pages:
         stamp = recorded.get(page.name)
         if stamp is None:

@@ -5,14 +5,19 @@ The pose is the identity rotation translated so that the mesh's lowest point sit
 ``z = mode.support_height_m`` (x = y = 0). The plan's seed is the runner's for trial
 :data:`UPRIGHT_TRIAL` (:func:`graspexp.core.seeding.plan_seed`). :func:`resting_pose` and
 :func:`posed_request` place it turned instead, with another trial's seed (``bench.plan_grasps``).
+
+A job that renders the depth camera (``perception.source=depth``, or a planner that reads it) gets the
+camera's observation of the object on the support and, with ``perception.source=depth``, the pose
+registered from it, as a trial does (:func:`graspexp.sim.perceive.perceive`, with that trial's seed).
 """
 
+import dataclasses
 import time
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from omegaconf import OmegaConf
+from omegaconf import DictConfig, OmegaConf
 
 from graspexp.core.seeding import plan_seed, trial_seed
 from graspexp.datasets import ObjectModel
@@ -61,9 +66,9 @@ def upright_request(cfg: Any, model: ObjectModel) -> PlanRequest:
 
 
 def posed_request(cfg: Any, model: ObjectModel, pose: np.ndarray, trial: int) -> PlanRequest:
-    """The planning request for ``model`` at the (4,4) world ``pose`` (seen without error) on the support
-    of job config ``cfg``, with the planner seed of trial ``trial``."""
-    return PlanRequest(
+    """The planning request for ``model`` at the (4,4) world ``pose`` on the support of job config ``cfg``,
+    with the planner seed of trial ``trial``: seen without error, or through the camera (module doc)."""
+    req = PlanRequest(
         points=model.points @ pose[:3, :3].T + pose[:3, 3],
         normals=model.normals @ pose[:3, :3].T,
         area_mask=np.asarray(model.area_mask, dtype=bool),
@@ -75,6 +80,19 @@ def posed_request(cfg: Any, model: ObjectModel, pose: np.ndarray, trial: int) ->
         cost=OmegaConf.to_object(cfg.cost),
         seed=plan_seed(trial_seed(cfg, model.name, trial)),
         support_blocks_gripper=bool(cfg.mode.support_collides_with_gripper),
+    )
+    from graspexp.sim.perceive import perceive, wants_camera
+
+    if not wants_camera(cfg):
+        return req
+    plain = OmegaConf.to_object(cfg) if isinstance(cfg, DictConfig) else cfg
+    seen = perceive(plain, model, pose, req.table_z, trial_seed(cfg, model.name, trial))
+    return dataclasses.replace(
+        req,
+        points=model.points @ seen.pose[:3, :3].T + seen.pose[:3, 3],
+        normals=model.normals @ seen.pose[:3, :3].T,
+        object_pose=seen.pose,
+        observation=seen.observation,
     )
 
 

@@ -10,6 +10,7 @@ from omegaconf import OmegaConf
 from graspexp.config import CostConfig, GripperConfig, OptimalConfig
 from graspexp.config.compose import compose_config
 from graspexp.perception import Observation
+from graspexp.perception.observation import given_normals
 from graspexp.planning import PlanRequest
 
 RG2 = GripperConfig(
@@ -125,7 +126,7 @@ def full_view(points: np.ndarray, normals: np.ndarray) -> Observation:
     return Observation(
         views=(),
         points=np.asarray(points, dtype=float),
-        normals=np.asarray(normals, dtype=float),
         point_ids=np.ones(len(points), dtype=np.int32),
         target_id=1,
+        normals_at=given_normals(normals),
     )

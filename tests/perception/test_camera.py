@@ -106,3 +106,34 @@ def test_observation_is_seeded_and_back_projects_onto_the_surface():
         in_cam = (world - v.world_from_camera[:3, 3]) @ v.world_from_camera[:3, :3]
         assert (in_cam[:, 2] > 0).all()
     assert len(view_poses(cfg.camera, 0.1)) == 2
+
+
+def test_the_target_normals_alone_equal_the_whole_clouds(data_root):
+    """The registration and the view-based planners read only the target's normals (estimated on the
+    target's neighbourhood, :class:`graspexp.perception.observe.ViewNormals`): on the mug (YCB google_16k)
+    seen from two sides they are the whole cloud's normals at those points, bit for bit."""
+    from omegaconf import OmegaConf
+
+    from graspexp.config.compose import compose_config
+    from graspexp.datasets import load_object
+
+    dataset = OmegaConf.to_object(
+        compose_config(["dataset=ycb", f"dataset.root={data_root / 'ycb'}"])
+    ).dataset
+    mesh = load_object(dataset, "025_mug", 256, 0).mesh
+    cfg = PerceptionConfig(camera=CameraConfig(azimuths_deg=[0.0, 150.0]))  # the d435 preset
+    support = BoxBody(np.array([-0.15, -0.15, 0.0]), np.array([0.15, 0.15, 0.1]))
+    for seed, turn in enumerate((0.0, 1.2, 2.5)):
+        pose = np.eye(4)
+        pose[:3, :3] = trimesh.transformations.rotation_matrix(turn, [0, 0, 1])[:3, :3]
+        pose[:3, 3] = [0.01, -0.02, 0.1 - mesh.bounds[0, 2]]
+        seen = [
+            observe(cfg, [MeshBody(mesh, pose, 1)], [support], 0.1, 1, rng=np.random.default_rng(seed))
+            for _ in range(2)
+        ]
+        pts, nrm = seen[0].target()  # first: only the target's normals are estimated
+        assert "normals" not in seen[0].__dict__ and len(pts) > 200
+        target = seen[1].point_ids == 1
+        assert (~target).sum() > 1000  # the support is in the cloud too
+        np.testing.assert_array_equal(pts, seen[1].points[target])
+        np.testing.assert_array_equal(nrm, seen[1].normals[target])

@@ -78,3 +78,26 @@ def test_too_few_observed_points_is_no_feasible_grasp():
     req = dataclasses.replace(req, planner=dataclasses.replace(req.planner, min_points=20))
     with pytest.raises(NoFeasibleGrasp, match="^antipodal_view: the camera saw 5 points"):
         plan(req)
+
+
+def test_the_plan_tool_renders_the_camera_for_a_folder_object(tmp_path, capsys):
+    """``python -m graspexp plan`` with a planner that reads the camera, on a folder dataset's object (a mesh
+    in mm): the camera renders the object upright on the support and the planner plans on its cloud; with
+    ``perception.source=depth`` the paper's planner gets the registered pose."""
+    import json
+
+    import trimesh
+
+    from graspexp.tools.plan import main
+
+    trimesh.creation.box(extents=(50.0, 30.0, 80.0)).export(tmp_path / "bracket.stl")
+    folder = ["dataset=folder", f"dataset.root={tmp_path}", "dataset.units=mm", "objects=[bracket]"]
+    assert main([*folder, "planner=antipodal_view"]) == 0
+    grasp = json.loads(capsys.readouterr().out)
+    assert grasp["object"] == "bracket" and grasp["n_feasible"] > 0
+    assert main([*folder, "perception.source=depth"]) == 0
+    registered = json.loads(capsys.readouterr().out)
+    assert main(folder) == 0
+    exact = json.loads(capsys.readouterr().out)
+    assert registered["pose"] != exact["pose"]  # planned on the registered pose, not the exact one
+    assert np.allclose(np.array(registered["pose"])[:3, 3], np.array(exact["pose"])[:3, 3], atol=0.02)

@@ -103,7 +103,10 @@ def test_overrides_merge_last_wins_and_pages_are_well_formed():
 
 @pytest.mark.slow
 def test_every_fingerprint_job_composes_and_names_its_objects():
-    jobs = {tuple(sorted(j)): j for page in PAGES for j in fingerprint_jobs(page)}
+    """Validated (so only the pages whose planners can run here: :func:`available`)."""
+    from graspexp.run.results import available
+
+    jobs = {tuple(sorted(j)): j for page in available(PAGES) for j in fingerprint_jobs(page)}
     for job in jobs.values():
         cfg = compose_validated(list(job))
         assert select_objects(cfg.dataset, cfg.objects), job
@@ -189,3 +192,46 @@ def test_a_tuning_page_scores_the_best_trial_or_the_farthest_tie():
     assert scored_trial(study([(1.0, 0.9), (2.0, 0.95), (50.0, 0.9)])) is None  # trial 1 beat the baseline
     assert scored_trial(study([(1.0, 0.9), (2.0, 0.9), (0.05, 0.9), (30.0, 0.8)])) == 2  # 20x, tied
     assert scored_trial(study([(1.0, 0.9), (3.0, 0.8)])) is None  # no tie: the best is trial 0 itself
+
+
+@pytest.mark.parametrize("name", ["camera", "learned"])
+def test_the_camera_and_learned_pages_fingerprint_jobs_compose(name):
+    """The fingerprint jobs of the pages made from camera trials compose (without validation: planner=vgn
+    needs the optional extra ``learned``, which a page whose planners cannot run here is skipped for) and
+    name Table 1 objects; each is a few single-trial jobs."""
+    from graspexp.config.compose import compose_config
+    from graspexp.report.paper import TABLE1
+
+    page = next(p for p in PAGES if p.name == name)
+    jobs = fingerprint_jobs(page)
+    assert 0 < len(jobs) <= 10
+    for job in jobs:
+        cfg = compose_config(list(job))
+        assert cfg.record is False and int(cfg.trials) == 1, job
+        assert set(cfg.objects) <= set(TABLE1.labels) and cfg.dataset.name == "ycb", job
+    planners = {compose_config(list(j)).planner.name for j in jobs}
+    assert "vgn" in planners and (name == "learned" or {"optimal", "antipodal_view"} <= planners)
+
+
+def test_a_page_whose_planner_cannot_run_here_is_skipped_with_one_line(monkeypatch, capsys):
+    """Without the optional extra (planner=vgn unavailable) the camera and learned pages are skipped by
+    ``results`` and ``results --check`` with one line naming the install command."""
+    from graspexp.config.planner import vgn
+    from graspexp.run.results import available
+
+    monkeypatch.setattr(vgn, "find_spec", lambda module: None)  # neither torch nor open3d installed
+    kept = available(PAGES)
+    assert {p.name for p in PAGES} - {p.name for p in kept} == {"camera", "learned"}
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 2 and all(
+        f"cannot run here: it needs torch and open3d, the optional extra 'learned': {vgn.INSTALL}" in line
+        for line in err
+    )
+    assert err[0].startswith("graspexp results: page camera (docs/results/camera.md) skipped: planner=vgn")
+
+
+def test_every_results_page_is_generated_but_the_labelled_experiments():
+    """Every page under docs/results/ is a :data:`PAGES` entry (``python -m graspexp results`` rewrites
+    it), but the experiments page (before/after studies, each naming its commits)."""
+    pages = {str(p.relative_to(ROOT)) for p in (ROOT / "docs" / "results").rglob("*.md")}
+    assert pages - {p.path for p in PAGES} == {"docs/results/experiments.md"}

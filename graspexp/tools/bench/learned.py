@@ -6,7 +6,8 @@ Usage::
         [planner=vgn] [gripper=panda] [mode=bin] [objects=[...]] [key=value ...]
 
 Each object stands upright on the support (:mod:`graspexp.run.upright`) and the simulated depth camera
-renders it once (``perception.camera.*``, the trial's own rendering and noise, :func:`graspexp.sim.perceive`);
+renders it once (``perception.camera.*``, the trial's own rendering and noise, :func:`graspexp.sim.perceive`,
+through :func:`graspexp.run.upright.upright_request`);
 then ``--runs`` plans on that observation are timed, on the wall clock and as CPU time of this process
 (torch's threads included; ``planner.threads`` sets how many). One row per object: p50 and p95 of the whole
 plan, and the p50 of its two steps as the planner logs them (``fuse``: the depth views into the TSDF;
@@ -19,34 +20,20 @@ import os
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-import dataclasses  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 from collections.abc import Sequence  # noqa: E402
 
 import numpy as np  # noqa: E402
-from omegaconf import OmegaConf  # noqa: E402
 
-from graspexp.core.seeding import trial_seed  # noqa: E402
 from graspexp.datasets import DatasetError, job_object, select_objects  # noqa: E402
 from graspexp.planning import NoFeasibleGrasp, PlanRequest, plan  # noqa: E402
-from graspexp.run.upright import UPRIGHT_TRIAL, upright_request  # noqa: E402
-from graspexp.sim.perceive import perceive  # noqa: E402
+from graspexp.run.upright import upright_request  # noqa: E402
 from graspexp.tools.cli import compose_checked, fail, tool_parser  # noqa: E402
 
 PROG = "graspexp bench.learned"
 DEFAULTS = ("planner=vgn", "gripper=panda", "dataset=ycb", "mode=bin")
 """The bench's job unless overridden: VGN with the gripper it was trained for, Table 1's objects."""
-
-
-def observed_request(cfg, name: str) -> PlanRequest:
-    """Object ``name`` upright on the support, with the camera's observation of it (as a trial renders it)."""
-    model = job_object(cfg, name)
-    req = upright_request(cfg, model)
-    seen = perceive(
-        OmegaConf.to_object(cfg), model, req.object_pose, req.table_z, trial_seed(cfg, name, UPRIGHT_TRIAL)
-    )
-    return dataclasses.replace(req, observation=seen.observation)
 
 
 def time_plans(req: PlanRequest, runs: int) -> dict[str, np.ndarray]:
@@ -79,7 +66,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     cfg = compose_checked([d for d in DEFAULTS if d.split("=")[0] not in given] + args.overrides, PROG)
     names = select_objects(cfg.dataset, cfg.objects)
     try:
-        requests = [(name, observed_request(cfg, name)) for name in names]
+        requests = [(name, upright_request(cfg, job_object(cfg, name))) for name in names]
     except DatasetError as err:
         fail(str(err), PROG)
     w0, c0 = time.perf_counter(), time.process_time()
