@@ -228,13 +228,18 @@ def _git(root: Path, *args: str) -> str:
     return subprocess.run(["git", *args], cwd=root, capture_output=True, text=True, check=True).stdout.strip()
 
 
+NOT_CODE = (":(exclude)docs", ":(exclude,glob)**/*.md")
+"""git pathspecs of the files that are documentation, not code: changes there do not mark a commit changed."""
+
+
 def commit_of(root: Path) -> tuple[str, str]:
     """(short commit, its date YYYY-MM-DD) of the checkout at ``root``; ``+changes`` is appended when
-    tracked files differ from the commit."""
+    tracked files other than the documentation differ from the commit (the pages a regeneration has written
+    so far change no number of the next page)."""
     try:
         commit = _git(root, "rev-parse", "--short", "HEAD")
         date = _git(root, "show", "-s", "--format=%cs", "HEAD")
-        changed = _git(root, "status", "--porcelain", "--untracked-files=no")
+        changed = _git(root, "status", "--porcelain", "--untracked-files=no", "--", ".", *NOT_CODE)
     except (OSError, subprocess.CalledProcessError):
         return "unknown", datetime.date.today().isoformat()
     return commit + ("+changes" if changed else ""), date

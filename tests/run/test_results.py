@@ -25,7 +25,7 @@ from graspexp.report.pages import (
     stamp,
 )
 from graspexp.run.result_pages import PAGES
-from graspexp.run.results import check, fingerprint_jobs, merged, regenerate
+from graspexp.run.results import check, commit_of, fingerprint_jobs, merged, regenerate
 from graspexp.tools.results import main as results_main
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -235,3 +235,20 @@ def test_every_results_page_is_generated_but_the_labelled_experiments():
     it), but the experiments page (before/after studies, each naming its commits)."""
     pages = {str(p.relative_to(ROOT)) for p in (ROOT / "docs" / "results").rglob("*.md")}
     assert pages - {p.path for p in PAGES} == {"docs/results/experiments.md"}
+
+
+def test_a_changed_page_is_not_a_code_change_but_a_changed_module_is(tmp_path: Path):
+    def git(*args: str) -> None:
+        subprocess.run(["git", "-c", "user.name=t", "-c", "user.email=t@t", *args], cwd=tmp_path, check=True)
+
+    (tmp_path / "docs").mkdir()
+    for name in ("README.md", "docs/page.md", "module.py"):
+        (tmp_path / name).write_text("a\n")
+    git("init", "-q")
+    git("add", ".")
+    git("commit", "-q", "-m", "first")
+    (tmp_path / "README.md").write_text("b\n")
+    (tmp_path / "docs" / "page.md").write_text("b\n")
+    assert not commit_of(tmp_path)[0].endswith("+changes")
+    (tmp_path / "module.py").write_text("b\n")
+    assert commit_of(tmp_path)[0].endswith("+changes")
