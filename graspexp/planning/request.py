@@ -1,6 +1,7 @@
 """What every planner receives; the planner contract is pure: request in, ``PlanResult`` out."""
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -63,6 +64,7 @@ class PlanRequest:
     observation: Observation | None = None
     neighbours: tuple[Neighbour, ...] = ()
 
+    @cached_property
     def neighbour_points(self) -> np.ndarray:
         """(N, 3) every neighbour's cloud stacked, world m (empty (0, 3) without neighbours)."""
         if not self.neighbours:
