@@ -126,8 +126,11 @@ def test_clutter_settings_it_cannot_run_are_one_line(override, message):
 
 
 @pytest.mark.slow
-def test_a_three_object_pile_round_runs_end_to_end_and_resumes(tmp_path):
+def test_a_three_object_pile_round_runs_end_to_end_resimulates_and_resumes(tmp_path):
+    from helpers.logs import strictly_valid
+
     from graspexp.record import read_round, read_trial
+    from graspexp.run.resim import resimulate
     from graspexp.run.runner import run_in_dir
 
     def cfg():
@@ -145,6 +148,11 @@ def test_a_three_object_pile_round_runs_end_to_end_and_resumes(tmp_path):
     assert {f"object_{i}" for i in range(3)} <= set(log.transforms)  # every object's pose over time
     assert len(log.grasps) == sum(a["executed"] for a in res.attempts)
     assert {"remove_tray", "settled", "plan", "close", "round_end"} <= {name for _, name, _ in log.phases}
+    with open(path, "rb") as f:
+        counts = strictly_valid(f)  # every message valid against its schema (Foxglove's and ours)
+    assert counts["/round"] == 1 and counts["/contacts"] > 0 and counts["/scene"] >= 2
+    agrees, why = resimulate(log)  # the heap re-settled from the round's seed, every attempt again
+    assert agrees, why
     attempts = (tmp_path / "attempts.csv").read_text().splitlines()
     assert len(attempts) == 1 + len(res.attempts)
     assert "GSR" in (tmp_path / "summary.md").read_text()
