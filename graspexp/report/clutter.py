@@ -9,7 +9,9 @@ from pathlib import Path
 
 import pandas as pd
 
+from graspexp.config.mode import CLUTTER_MODES
 from graspexp.core.clutter import RoundEnd, RoundResult
+from graspexp.core.run_layout import TRIALS_DIR
 from graspexp.record import CorruptLogError, iter_trial_logs, read_round
 from graspexp.report.stats import percentiles, success_pct
 
@@ -58,6 +60,15 @@ def read_rounds(run_dir: Path | str) -> list[RoundResult]:
     if out or not (Path(run_dir) / ROUNDS_CSV).is_file():
         return out
     return _rounds_from_csv(Path(run_dir))
+
+
+def find_rounds(root: Path | str) -> list[RoundResult]:
+    """Every round below ``root`` (a run or a sweep directory): the run directories that hold a ``rounds.csv``
+    or round logs (``trials/pile/``, ``trials/packed/``), each read by :func:`read_rounds`."""
+    root = Path(root)
+    runs = {p.parent for p in root.rglob(ROUNDS_CSV)}
+    runs |= {d.parent for mode in CLUTTER_MODES for d in root.rglob(f"{TRIALS_DIR}/{mode}") if d.is_dir()}
+    return [r for run in sorted(runs) for r in read_rounds(run)]
 
 
 def _rounds_from_csv(run_dir: Path) -> list[RoundResult]:
