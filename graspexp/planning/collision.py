@@ -32,6 +32,7 @@ from graspexp.config import GripperConfig
 from graspexp.grippers import GripperGeometry
 from graspexp.planning.hull_sweep import hull_cloud_hits, hull_lowest_z
 from graspexp.planning.kernels import COUNT_ALL, box_lowest_z, swept_box_hits
+from graspexp.planning.neighbour_kernels import between_pads_hits
 from graspexp.planning.pose import slab_spans_m
 
 
@@ -105,10 +106,6 @@ def cloud_hits(
     )
 
 
-NEIGHBOUR_CHUNK = 64
-"""Grasps whose between-the-pads test of :func:`neighbour_hits` runs in one array pass."""
-
-
 def neighbour_hits(
     points_m: np.ndarray,
     poses: np.ndarray,
@@ -128,19 +125,9 @@ def neighbour_hits(
         return np.zeros(len(poses), dtype=bool)
     out = cloud_hits(points_m, poses, gripper, widths, sweep_m=sweep_m, margin_m=margin_m, stop_at=1) > 0
     g, m = GripperGeometry.of(gripper), margin_m
-    for start in range(0, len(poses), NEIGHBOUR_CHUNK):
-        part = slice(start, start + NEIGHBOUR_CHUNK)
-        rot, origin = poses[part, :3, :3], poses[part, :3, 3]
-        local = np.einsum(
-            "bji,bnj->bni", rot, points_m[None, :, :] - origin[:, None, :]
-        )  # (b, N, 3) grasp frame
-        between = (
-            (np.abs(local[..., 0]) <= g.finger_width_m / 2 + m)
-            & (np.abs(local[..., 1]) < widths[part, None] / 2)
-            & (local[..., 2] >= g.root_z_m - sweep_m - m)
-            & (local[..., 2] <= g.tip_z_m + m)
-        )
-        out[part] |= between.any(axis=1)
+    box = np.array([g.finger_width_m / 2 + m, g.root_z_m - sweep_m - m, g.tip_z_m + m])
+    pts = np.ascontiguousarray(points_m, dtype=np.float64)
+    out |= between_pads_hits(pts, poses, np.ascontiguousarray(widths / 2), box)
     return out
 
 

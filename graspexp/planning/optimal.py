@@ -141,7 +141,12 @@ def paper_candidates(req: PlanRequest, planner: str, cluster_length_m: float | N
         )
     if req.neighbours:  # III-D's rule for the support, for the other objects of a clutter round
         feasible &= clear_of(
-            centers, directions, pl.sphere_radius_m, req.neighbour_points, pl.neighbour_voxel_m
+            centers,
+            clusters.radii_m,
+            directions,
+            pl.sphere_radius_m,
+            req.neighbour_points,
+            pl.neighbour_voxel_m,
         )
         if not feasible.any():
             raise NoFeasibleGrasp(
@@ -262,6 +267,7 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
             "centre_shift_m": shift_m,
             "widened": widened,
             **({"n_collides": n_collides} if pl.swept_check else {}),
+            **({"touches_neighbours": bool(tests.relaxed[0])} if req.neighbours else {}),
             **({"n_outside_area": n_outside, "in_area_required": float(need)} if need > 0 else {}),
         },
     )
@@ -280,12 +286,16 @@ class PathTests:
 
     spans : (K, M, 2) [y_lo, y_hi] of the object's section between the pads about c_k, m; section : its
     extent, m; share : the smaller pad's share of contact points in the grasping area; free : the opened
-    gripper's swept fingers and palm clear of the cloud and of a blocking support."""
+    gripper's swept fingers and palm clear of the cloud and of a blocking support (and of a clutter round's
+    neighbours); alone : the same without the neighbours; relaxed : (1,) whether ``free`` was relaxed to
+    ``alone`` (``planner.neighbour_fallback``)."""
 
     spans: np.ndarray
     section: np.ndarray
     share: np.ndarray
     free: np.ndarray
+    alone: np.ndarray
+    relaxed: np.ndarray
 
     @classmethod
     def empty(cls, k: int, m: int) -> "PathTests":
@@ -294,6 +304,8 @@ class PathTests:
             np.full((k, m), np.nan),
             np.full((k, m), np.nan),
             np.ones((k, m), bool),
+            np.ones((k, m), bool),
+            np.zeros(1, bool),
         )
 
 
@@ -330,6 +342,10 @@ def _choose_path(
             f"section between the pads exceeds gripper.max_width_m = {gr.max_width_m} m"
         )
     clear = fits_stroke & tests.free
+    if not clear.any() and req.neighbours and pl.neighbour_fallback:  # touching a neighbour is allowed
+        tests.free[:] = tests.alone
+        tests.relaxed[0] = True
+        clear = fits_stroke & tests.free
     if not clear.any():
         raise NoFeasibleGrasp(
             f"{pl.name}: on all {len(order)} paths above the support whose section fits the stroke the "
@@ -387,6 +403,7 @@ def _test_batch(
         if req.support_blocks_gripper:
             free &= lowest_z(poses, gr, widths, pl.sphere_radius_m) >= req.table_z
         if req.neighbours:
+            tests.alone[ks, ps] = free
             free &= ~neighbour_hits(
                 req.neighbour_points, poses, gr, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0
             )

@@ -340,7 +340,7 @@ def _plan_scene(
             wall, cpu, n = wall + time.perf_counter() - t0, cpu + time.thread_time() - c0, n + 1
             if grasp is not None:
                 cost = grasp.cost if np.isfinite(grasp.cost) else np.inf
-                plans.append((cost, rank, name, grasp))
+                plans.append((bool(grasp.extras.get("touches_neighbours", False)), cost, rank, name, grasp))
                 if cfg.mode.pick_order == "top_most":
                     break
     first = seen[order[0]][0]
@@ -352,7 +352,7 @@ def _plan_scene(
     if not plans:
         sim.phase("plan", {"attempt": attempt, "found": False, "n_planned": n})
         return row, None
-    _, _, name, grasp = min(plans, key=lambda p: (p[0], p[1]))
+    *_, name, grasp = min(plans, key=lambda p: p[:3])  # a grasp clear of the neighbours first, then cost
     slot = seen[name][0]
     row.target, row.slot, row.executed, row.reason = ctx.objects[slot].model.name, slot, True, None
     row.grasp_cost, row.grasp_width_m, row.n_feasible = grasp.cost, grasp.width_m, grasp.n_feasible

@@ -49,9 +49,11 @@ def test_paths_through_an_obstacle_are_dropped():
     obstacle = np.array(
         [[-0.05, 0.0, 0.0]]
     )  # on the first path only: its sphere point is c - r d = (-0.1, 0, 0)
-    ok = clear_of(centers, directions, 0.1, obstacle, 0.01)
+    ok = clear_of(centers, np.array([0.02]), directions, 0.1, obstacle, 0.01)
     assert ok.tolist() == [[False, True, True]]
-    assert clear_of(centers, directions, 0.1, np.zeros((0, 3)), 0.01).all()
+    assert clear_of(centers, np.array([0.02]), directions, 0.1, np.zeros((0, 3)), 0.01).all()
+    near = np.array([[-0.01, 0.0, 0.0]])  # within the cluster radius: the swept check's part of the path
+    assert clear_of(centers, np.array([0.02]), directions, 0.1, near, 0.01).all()
 
 
 @pytest.mark.parametrize(
