@@ -53,8 +53,8 @@ class ModeConfig:
     """``pile``: height of the lowest point of each object above the table at release, m (VGN: 0.2 m);
     the objects are dropped one after another, each once the earlier ones rest."""
     placement_gap_m: float = 0.01
-    """``packed``: least gap between the footprints (circles about each object's vertical axis through its
-    bounding-box centre) of two objects placed upright, m: side by side, not touching."""
+    """``packed``: least gap between the footprints (each model's x-y bounding rectangle, turned by its yaw)
+    of two objects placed upright, m: side by side, not touching."""
     pick_order: str = "lowest_cost"
     """``pile``/``packed``: which object to grasp next. ``lowest_cost``: plan every object on the table (the
     planner sees the others as obstacles) and execute the grasp of least cost (the paper's Eq. 2-3 choice

@@ -127,27 +127,53 @@ def pile_drop_pose(
 def packed_poses(
     models: list[ObjectModel], mode: ModeConfig, gap_m: float, rng: np.random.Generator
 ) -> list[np.ndarray | None]:
-    """Upright (the model's own +Z up, random yaw) places in the workspace whose footprints (circles about
-    the vertical axis through each rotated bounding box's centre) keep ``mode.placement_gap_m`` apart; the
-    lowest point ``gap_m`` above the table. None for an object that found no place in :data:`PLACE_TRIES`
-    tries (it is left out of the round)."""
+    """Upright (the model's own +Z up, random yaw) places in the workspace whose footprints keep
+    ``mode.placement_gap_m`` apart: each footprint is the model's x-y bounding rectangle turned by the yaw
+    (separating-axis test), lying wholly inside ``mode.workspace_half_size_m``; the lowest point ``gap_m``
+    above the table. Placed in slot order; None for an object that found no place in :data:`PLACE_TRIES`
+    tries (left out: a round of large objects places fewer)."""
     ws = np.asarray(mode.workspace_half_size_m, dtype=float)
-    placed: list[tuple[np.ndarray, float]] = []
-    out: list[np.ndarray | None] = []
-    for model in models:
-        R = yaw_rotation(rng.uniform(0.0, 2.0 * np.pi))
-        v = model.mesh.vertices @ R.T
-        lo, hi = v.min(axis=0), v.max(axis=0)
-        mid = (lo + hi)[:2] / 2
-        radius = float(np.linalg.norm(v[:, :2] - mid, axis=1).max())
-        room = np.maximum(ws - radius, 0.0)
-        pose = None
+    placed: list[
+        tuple[np.ndarray, np.ndarray, np.ndarray]
+    ] = []  # (centre (2,), axes (2, 2) columns, half (2,))
+    out: list[np.ndarray | None] = [None] * len(models)
+    bounds = [(m.mesh.vertices.min(axis=0), m.mesh.vertices.max(axis=0)) for m in models]
+    for i in range(len(models)):
+        lo, hi = bounds[i]
+        mid, half = (lo + hi)[:2] / 2, (hi - lo)[:2] / 2
         for _ in range(PLACE_TRIES):
-            xy = rng.uniform(-room, room)
-            if all(np.linalg.norm(xy - c) >= radius + r + mode.placement_gap_m for c, r in placed):
-                placed.append((xy, radius))
-                t = np.array([xy[0] - mid[0], xy[1] - mid[1], float(mode.support_height_m) + gap_m - lo[2]])
-                pose = make_pose(R, t)
+            R = yaw_rotation(rng.uniform(0.0, 2.0 * np.pi))
+            axes = R[:2, :2]
+            reach = np.abs(axes) @ half  # (2,) half extents of the turned rectangle's bounding box
+            room = ws - reach
+            if np.any(room < 0):
+                continue
+            centre = rng.uniform(-room, room)
+            if all(_apart(centre, axes, half, *other, mode.placement_gap_m) for other in placed):
+                placed.append((centre, axes, half))
+                t = np.zeros(3)
+                t[:2] = centre - axes @ mid
+                t[2] = float(mode.support_height_m) + gap_m - lo[2]
+                out[i] = make_pose(R, t)
                 break
-        out.append(pose)
     return out
+
+
+def _apart(
+    c1: np.ndarray,
+    a1: np.ndarray,
+    h1: np.ndarray,
+    c2: np.ndarray,
+    a2: np.ndarray,
+    h2: np.ndarray,
+    gap_m: float,
+) -> bool:
+    """Whether two turned rectangles (centre (2,), unit axes as columns (2, 2), half sizes (2,)) are at least
+    ``gap_m`` apart along some axis of either (separating-axis test)."""
+    d = c2 - c1
+    for axis in (*a1.T, *a2.T):
+        r1 = np.abs(a1.T @ axis) @ h1
+        r2 = np.abs(a2.T @ axis) @ h2
+        if abs(d @ axis) >= r1 + r2 + gap_m:
+            return True
+    return False

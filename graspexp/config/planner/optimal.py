@@ -38,9 +38,9 @@ class PaperPathsConfig(PlannerConfig):
     that object's cloud. 1 cm: wider than the spacing of a sampled cloud (about 5 mm on a 10 cm object
     with 1024 points), so no path slips between the points of a surface it crosses; no effect on one object."""
     neighbour_fallback: bool = True
-    """Clutter rounds: when the swept gripper of every path meets a neighbour (and the target and support
-    are clear on some), take the cheapest path clear of the target and the support
-    (``extras["touches_neighbours"]``) instead of finding no grasp. The protocol lets the gripper touch
+    """Clutter rounds: when the swept gripper of every path meets a neighbour, ``optimal`` takes the cheapest
+    path clear of the target and the support, ``optimal_plus`` the grasp it plans for the target alone
+    (``extras["touches_neighbours"]``), instead of finding no grasp. The protocol lets the gripper touch
     the other objects (VGN executes with ``allow_contact=True``); in a heap, a palm 15 cm wide meets a
     neighbour on nearly every path. No effect on one object."""
     seed: int = 0
