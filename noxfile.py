@@ -136,13 +136,15 @@ def wheel(session: nox.Session) -> None:
 @nox.session
 def bench(session: nox.Session) -> None:
     """Planner latency per Table 1 object, registration accuracy and depth + registration time per Table
-    1/2 object (the camera extra), the per-phase trial benchmark, then the 720-trial reproduction
+    1/2 object (the camera extra), the per-phase trial benchmark, the clutter benchmark (a round's attempt
+    beside a bin trial, planning latency per scene), then the 720-trial reproduction
     (logged, warm collision cache) with 1 and 2 workers; then, where the optional extra ``learned``
     installs, the learned planners' inference time (``bench.learned``)."""
     session.install("-e", ".[camera]")
     session.run("python", "-m", "graspexp", "bench.plan_latency", *session.posargs, env=ENV)
     session.run("python", "-m", "graspexp", "bench.registration", *session.posargs, env=ENV)
     session.run("python", "-m", "graspexp", "bench.trials", *session.posargs, env=ENV)
+    session.run("python", "-m", "graspexp", "bench.clutter", "dataset=ycb", env=ENV)
     session.run("python", "-m", "graspexp", "bench.reproduce", *session.posargs, env=ENV)
     if _install_learned(session):  # the learned planners' inference time, where the extra installs
         env = {**ENV, "GRASPEXP_CHECKPOINTS": CHECKPOINTS}

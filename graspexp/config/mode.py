@@ -1,6 +1,7 @@
-"""Schema of the ``mode`` config group: collaborative hand-over or bin picking (paper IV-A, IV-C)."""
+"""Schema of the ``mode`` config group: collaborative hand-over or bin picking (paper IV-A, IV-C), and
+clutter removal (``pile``, ``packed``: VGN, Breyer et al. CoRL 2020; GIGA, Jiang et al. RSS 2021)."""
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from omegaconf import MISSING
 
@@ -10,7 +11,9 @@ from graspexp.config.constraints import BOOL, Interval, Options, Vector
 @dataclass
 class ModeConfig:
     name: str = MISSING
-    """``collab`` (Eq. 1; box removed after the grasp) or ``bin`` (Eq. 2-3; table, pull back)."""
+    """``collab`` (Eq. 1; box removed after the grasp) or ``bin`` (Eq. 2-3; table, pull back): one object per
+    trial; ``pile`` or ``packed``: a clutter-removal round of :attr:`objects_per_round` objects on the table,
+    grasped one at a time (Eq. 2-3, pull back and lift as in ``bin``; :mod:`graspexp.sim.clutter`)."""
     support_height_m: float = 0.10
     """Height of the support's top face above the ground plane, m (the plane z = h)."""
     support_half_size_m: list[float] = MISSING
@@ -29,10 +32,45 @@ class ModeConfig:
     """Bin mode: extra lift along world +Z after the pull back, m."""
     hold_s: float = 2.0
     """Time the grasp must hold at the end, s."""
+    objects_per_round: int = 5
+    """``pile``/``packed``: objects drawn from the pool (``objects``, else the dataset's list) per round, seeded
+    per round; without replacement when the pool holds enough, else with. 5: VGN's and GIGA's rounds."""
+    max_consecutive_failures: int = 2
+    """``pile``/``packed``: the round ends after this many failed grasp attempts in a row (VGN's
+    ``MAX_CONSECUTIVE_FAILURES = 2``, ethz-asl/vgn src/vgn/experiments/clutter_removal.py)."""
+    workspace_half_size_m: list[float] = field(default_factory=lambda: [0.15, 0.15])
+    """``pile``/``packed``: half extents [x, y] of the square the objects are placed in, centred on the table,
+    m. An object whose centre of mass is outside it (or off the table) once the scene has settled is taken
+    away before the first attempt and not counted as placed. 0.3 m: VGN's workspace (``size`` 0.3 m, its
+    ``remove_objects_outside_roi``)."""
+    tray_half_size_m: list[float] = field(default_factory=lambda: [0.1, 0.1])
+    """``pile``: inner half extents [x, y] of the box the objects are dropped into, m; it is lifted away once
+    they rest, leaving a heap. 0.2 m: VGN drops into the middle third of its 0.3 m workspace inside a box;
+    a box narrower than a long object (LINEMOD iron 258 mm) still holds it, tilted."""
+    tray_wall_height_m: float = 0.15
+    """``pile``: height of the box's walls above the table, m (higher than a heap of five YCB objects)."""
+    drop_height_m: float = 0.2
+    """``pile``: height of the lowest point of each object above the table at release, m (VGN: 0.2 m);
+    the objects are dropped one after another, each once the earlier ones rest."""
+    placement_gap_m: float = 0.01
+    """``packed``: least gap between the footprints (each model's x-y bounding rectangle, turned by its yaw)
+    of two objects placed upright, m: side by side, not touching."""
+    pick_order: str = "lowest_cost"
+    """``pile``/``packed``: which object to grasp next. ``lowest_cost``: plan every object on the table (the
+    planner sees the others as obstacles) and execute the grasp of least cost (the paper's Eq. 2-3 choice
+    extended over the objects: the same rule that picks a path picks the object); ``top_most``: plan the
+    objects from the highest top down and execute the first grasp found (a heap is cleared from the top,
+    the order a person follows, and only one plan is paid per attempt when it succeeds)."""
+
+
+CLUTTER_MODES = ("pile", "packed")
+"""The modes whose trials are clutter-removal rounds (:mod:`graspexp.sim.clutter`)."""
+PICK_ORDERS = ("lowest_cost", "top_most")
+"""The values of ``mode.pick_order``."""
 
 
 CONSTRAINTS = {
-    "name": [Options(("collab", "bin"))],
+    "name": [Options(("collab", "bin", *CLUTTER_MODES))],
     "support_height_m": [Interval(0, 2, "right", "m")],
     "support_half_size_m": [Vector(2, Interval(0, 5, "right", "m"))],
     "support_collides_with_gripper": BOOL,
@@ -40,5 +78,13 @@ CONSTRAINTS = {
     "pull_back_m": [Interval(0, 2, unit="m")],
     "lift_m": [Interval(0, 2, unit="m")],
     "hold_s": [Interval(0, 60, "right", "s")],
+    "objects_per_round": [Interval(1, 50, integer=True)],
+    "max_consecutive_failures": [Interval(1, 100, integer=True)],
+    "workspace_half_size_m": [Vector(2, Interval(0, 5, "right", "m"))],
+    "tray_half_size_m": [Vector(2, Interval(0, 5, "right", "m"))],
+    "tray_wall_height_m": [Interval(0, 2, "right", "m")],
+    "drop_height_m": [Interval(0, 2, unit="m")],
+    "placement_gap_m": [Interval(0, 1, unit="m")],
+    "pick_order": [Options(PICK_ORDERS)],
 }
 """Allowed values of every key (see :mod:`graspexp.config.constraints`)."""

@@ -6,3 +6,10 @@ SUPPORT_NAME = "support"
 GROUND_NAME = "ground"
 PALM_NAME = "palm"
 FINGER_NAMES: tuple[str, str] = ("finger_left", "finger_right")
+TRAY_NAME = "tray"
+"""The walls of the box a pile is dropped into (``mode=pile``), removed before the first attempt."""
+
+
+def clutter_body(slot: int) -> str:
+    """Name of the body of a clutter round's object ``slot`` (its /tf frame and /contacts name)."""
+    return f"{OBJECT_NAME}_{slot}"

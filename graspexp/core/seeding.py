@@ -17,6 +17,12 @@ def trial_seed(job: Any, object_name: str, trial: int) -> int:
     return derive_seed(job.seed, job.dataset.name, object_name, trial)
 
 
+def round_seed(job: Any, round_index: int) -> int:
+    """Seed of one clutter round (``mode=pile``/``packed``) of job config ``job``: from (global seed, dataset,
+    mode, round index); it draws the round's objects, their places and every attempt's draws."""
+    return derive_seed(job.seed, job.dataset.name, job.mode.name, "round", round_index)
+
+
 def plan_seed(trial_seed: int) -> int:
     """The planner's seed in the trial of ``trial_seed`` (:attr:`PlanRequest.seed`)."""
     return derive_seed(trial_seed, "plan")

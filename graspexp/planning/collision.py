@@ -32,6 +32,7 @@ from graspexp.config import GripperConfig
 from graspexp.grippers import GripperGeometry
 from graspexp.planning.hull_sweep import hull_cloud_hits, hull_lowest_z
 from graspexp.planning.kernels import COUNT_ALL, box_lowest_z, swept_box_hits
+from graspexp.planning.neighbour_kernels import between_pads_hits
 from graspexp.planning.pose import slab_spans_m
 
 
@@ -103,6 +104,31 @@ def cloud_hits(
         palm,
         stop_at,
     )
+
+
+def neighbour_hits(
+    points_m: np.ndarray,
+    poses: np.ndarray,
+    gripper: GripperConfig,
+    widths_m: np.ndarray,
+    *,
+    sweep_m: float,
+    margin_m: float,
+) -> np.ndarray:
+    """(B,) bool: whether the opened gripper, swept ``sweep_m`` along its approach, meets a point of the other
+    objects' cloud ``points_m`` ((N, 3) world m) of a clutter round: in the finger and palm volumes
+    (:func:`cloud_hits`) or between the pads (the fingers would close on it together with the target):
+    ``|x| <= fw/2``, ``|y| < w/2``, ``z`` from the swept palm face to the fingertips, grown by ``margin_m``."""
+    poses = np.ascontiguousarray(np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4))
+    widths = np.broadcast_to(np.asarray(widths_m, dtype=np.float64), (len(poses),))
+    if len(points_m) == 0 or len(poses) == 0:
+        return np.zeros(len(poses), dtype=bool)
+    out = cloud_hits(points_m, poses, gripper, widths, sweep_m=sweep_m, margin_m=margin_m, stop_at=1) > 0
+    g, m = GripperGeometry.of(gripper), margin_m
+    box = np.array([g.finger_width_m / 2 + m, g.root_z_m - sweep_m - m, g.tip_z_m + m])
+    pts = np.ascontiguousarray(points_m, dtype=np.float64)
+    out |= between_pads_hits(pts, poses, np.ascontiguousarray(widths / 2), box)
+    return out
 
 
 def support_lift_m(
@@ -201,6 +227,7 @@ def place_grasps(
     clearance_m: float,
     max_lift_m: float,
     min_widths_m: np.ndarray | float = 0.0,
+    obstacles_m: np.ndarray | None = None,
 ) -> Placement:
     """Open, lift and check a batch of candidate grasps against the cloud and the support.
 
@@ -211,9 +238,10 @@ def place_grasps(
     2. move the grasp back along -Z by :func:`support_lift_m` (at most ``max_lift_m``, else rejected as
        below the support), then re-centre and recompute the opening there;
     3. reject when the opening exceeds ``gripper.max_width_m`` (too wide), when a box still dips below
-       ``table_z + margin_m`` (below support), or when :func:`cloud_hits` finds a point (collides).
+       ``table_z + margin_m`` (below support), or when :func:`cloud_hits` finds a point (collides), or
+       :func:`neighbour_hits` a point of ``obstacles_m`` (the other objects of a clutter round).
 
-    points_m : (N, 3) world cloud; poses : (B, 4, 4) world candidate poses.
+    points_m : (N, 3) world cloud; poses : (B, 4, 4) world candidate poses; obstacles_m : (M, 3) world or None.
     """
     poses = np.array(poses, dtype=np.float64).reshape(-1, 4, 4)
     b = len(poses)
@@ -252,6 +280,10 @@ def place_grasps(
         hits[check] = cloud_hits(
             points_m, poses[check], gripper, widths[check], sweep_m=sweep_m, margin_m=margin_m, stop_at=1
         )
+        if obstacles_m is not None and len(obstacles_m):
+            hits[check] += neighbour_hits(
+                obstacles_m, poses[check], gripper, widths[check], sweep_m=sweep_m, margin_m=margin_m
+            )
     collides = check & (hits > 0)
     return Placement(
         poses=poses,
@@ -277,7 +309,8 @@ def max_lift_m(gripper: GripperConfig) -> float:
 def place_for_request(req, poses: np.ndarray, min_widths_m: np.ndarray | float = 0.0) -> Placement:
     """:func:`place_grasps` with the request's cloud, support plane, gripper and planner settings
     (sweep = ``planner.sphere_radius_m``, ``collision_margin_m``, ``width_clearance_m``). A support that
-    does not block the gripper (``req.support_blocks_gripper`` False) is not checked."""
+    does not block the gripper (``req.support_blocks_gripper`` False) is not checked; a clutter round's other
+    objects (``req.neighbours``) are obstacles (:func:`neighbour_hits`)."""
     pl, gr = req.planner, req.gripper
     return place_grasps(
         np.asarray(req.points, dtype=np.float64),
@@ -289,4 +322,5 @@ def place_for_request(req, poses: np.ndarray, min_widths_m: np.ndarray | float =
         clearance_m=pl.width_clearance_m,
         max_lift_m=max_lift_m(gr),
         min_widths_m=min_widths_m,
+        obstacles_m=req.neighbour_points if req.neighbours else None,
     )

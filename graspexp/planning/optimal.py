@@ -14,7 +14,9 @@ object pose: world frame, metres):
    ``random_state = derive_seed(req.seed, "kmeans", planner.seed)``;
 4. ``M`` Fibonacci-sphere paths per centre, radius ``planner.sphere_radius_m`` (III-C, Fig. 6);
 5. paths whose sphere point lies below ``z = table_z + planner.table_clearance_m`` are removed, in both
-   modes (the plane is the box top in collab mode, the table top in bin mode; Fig. 8);
+   modes (the plane is the box top in collab mode, the table top in bin mode; Fig. 8); in a clutter round
+   (``req.neighbours``) so are the paths that pass through another object (III-D's reason;
+   :func:`.paths.clear_of`, ``planner.neighbour_voxel_m``);
 6. cost Eq. (1) (collab) or Eq. (2)-(3) (bin) of every remaining path (:mod:`.cost`); removed paths
    cost ``inf``;
 7. paths are taken in ascending cost (stable order: cluster-major, then path index) and the first that
@@ -23,7 +25,8 @@ object pose: world frame, metres):
    ``y_hi - y_lo``) fits its opening ``w_k = clip(2 r_k (1 + width_margin), min_width, max_width)``;
    ``planner.swept_check``: the fingers and palm opened to the path's width, swept from the sphere point
    to the grasp pose, meet no cloud point and, where ``req.support_blocks_gripper``, stay above the
-   support (:mod:`.collision`, margin 0; ``extras["n_collides"]``); ``planner.min_contacts_in_area``
+   support, and in a clutter round meet no neighbour's point, between the pads included
+   (:mod:`.collision`, :func:`.collision.neighbour_hits`, margin 0; ``extras["n_collides"]``); ``planner.min_contacts_in_area``
    > 0: at least that share of each pad's contact points are grasping-area points
    (:func:`.stability.pad_contacts`; ``extras["n_outside_area"]``, ``extras["in_area_required"]``).
    Checking lazily in cost order picks exactly the argmin over the paths passing every test; examined
@@ -50,11 +53,11 @@ from graspexp.core.seeding import derive_seed
 from graspexp.grippers import GripperGeometry
 from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
 from graspexp.planning.clusters import Clusters, choose_k, elongation, main_axis, max_radii_m, segment
-from graspexp.planning.collision import cloud_hits, lowest_z
+from graspexp.planning.collision import cloud_hits, lowest_z, neighbour_hits
 from graspexp.planning.cost import all_path_costs
 from graspexp.planning.details import OptimalDetails
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
-from graspexp.planning.paths import above_support, approach_directions
+from graspexp.planning.paths import above_support, approach_directions, clear_of
 from graspexp.planning.pose import grasp_rotation, grasp_rotations, opening_widths_m, slab_spans_m
 from graspexp.planning.request import PlanRequest, PlanResult
 from graspexp.planning.stability import pad_contacts
@@ -136,6 +139,19 @@ def paper_candidates(req: PlanRequest, planner: str, cluster_length_m: float | N
             f"{planner}: every one of the {k * m} paths starts below the support plane z = "
             f"{req.table_z + pl.table_clearance_m:.4f} m (sphere radius {pl.sphere_radius_m} m)"
         )
+    if req.neighbours:  # III-D's rule for the support, for the other objects of a clutter round
+        feasible &= clear_of(
+            centers,
+            clusters.radii_m,
+            directions,
+            pl.sphere_radius_m,
+            req.neighbour_points,
+            pl.neighbour_voxel_m,
+        )
+        if not feasible.any():
+            raise NoFeasibleGrasp(
+                f"{planner}: every one of the {k * m} paths passes through the support or another object"
+            )
     costs = path_costs(req, points, axis, clusters, directions, feasible)
     return Candidates(points, mask, axis, pose_axis, clusters, directions, feasible, costs)
 
@@ -251,6 +267,7 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
             "centre_shift_m": shift_m,
             "widened": widened,
             **({"n_collides": n_collides} if pl.swept_check else {}),
+            **({"touches_neighbours": bool(tests.relaxed[0])} if req.neighbours else {}),
             **({"n_outside_area": n_outside, "in_area_required": float(need)} if need > 0 else {}),
         },
     )
@@ -269,12 +286,16 @@ class PathTests:
 
     spans : (K, M, 2) [y_lo, y_hi] of the object's section between the pads about c_k, m; section : its
     extent, m; share : the smaller pad's share of contact points in the grasping area; free : the opened
-    gripper's swept fingers and palm clear of the cloud and of a blocking support."""
+    gripper's swept fingers and palm clear of the cloud and of a blocking support (and of a clutter round's
+    neighbours); alone : the same without the neighbours; relaxed : (1,) whether ``free`` was relaxed to
+    ``alone`` (``planner.neighbour_fallback``)."""
 
     spans: np.ndarray
     section: np.ndarray
     share: np.ndarray
     free: np.ndarray
+    alone: np.ndarray
+    relaxed: np.ndarray
 
     @classmethod
     def empty(cls, k: int, m: int) -> "PathTests":
@@ -283,6 +304,8 @@ class PathTests:
             np.full((k, m), np.nan),
             np.full((k, m), np.nan),
             np.ones((k, m), bool),
+            np.ones((k, m), bool),
+            np.zeros(1, bool),
         )
 
 
@@ -319,10 +342,16 @@ def _choose_path(
             f"section between the pads exceeds gripper.max_width_m = {gr.max_width_m} m"
         )
     clear = fits_stroke & tests.free
+    if not clear.any() and req.neighbours and pl.neighbour_fallback:  # touching a neighbour is allowed
+        tests.free[:] = tests.alone
+        tests.relaxed[0] = True
+        clear = fits_stroke & tests.free
     if not clear.any():
         raise NoFeasibleGrasp(
             f"{pl.name}: on all {len(order)} paths above the support whose section fits the stroke the "
-            "opened gripper's swept fingers or palm meet the object or the support (planner.swept_check)"
+            "opened gripper's swept fingers or palm meet the object or the support"
+            + (" or another object" if req.neighbours else "")
+            + " (planner.swept_check)"
         )
     ok = clear
     if need > 0:
@@ -373,6 +402,11 @@ def _test_batch(
         free = cloud_hits(points, poses, gr, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0, stop_at=1) == 0
         if req.support_blocks_gripper:
             free &= lowest_z(poses, gr, widths, pl.sphere_radius_m) >= req.table_z
+        if req.neighbours:
+            tests.alone[ks, ps] = free
+            free &= ~neighbour_hits(
+                req.neighbour_points, poses, gr, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0
+            )
         tests.free[ks, ps] = free
         ok &= free
     return ok

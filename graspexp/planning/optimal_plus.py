@@ -50,6 +50,7 @@ inf where removed by the plane test), ``com`` and the ``shortlist`` of the S pas
 (:mod:`graspexp.run.bench.shortlist` simulates each of them).
 """
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -92,13 +93,30 @@ def _check_params(pl) -> None:
 
 
 def plan_optimal_plus(req: PlanRequest) -> PlanResult:
-    """Plan one grasp with the paper's candidates and the checks of the module doc.
+    """Plan one grasp with the paper's candidates and the checks of the module doc. In a clutter round, when
+    no grasp clears the neighbours and ``planner.neighbour_fallback`` is on, the grasp planned for the target
+    alone (touching a neighbour is allowed; ``extras["touches_neighbours"]``).
 
     Raises
     ------
     NoFeasibleGrasp
         Empty grasping area; every path crosses the support plane; or no path passes checks 1-3.
     """
+    try:
+        result = _plan(req)
+    except NoFeasibleGrasp:
+        if not (req.neighbours and req.planner.neighbour_fallback):
+            raise
+        result = _plan(dataclasses.replace(req, neighbours=()))
+        result.grasp.extras["touches_neighbours"] = True
+        return result
+    if req.neighbours:
+        result.grasp.extras["touches_neighbours"] = False
+    return result
+
+
+def _plan(req: PlanRequest) -> PlanResult:
+    """:func:`plan_optimal_plus` with the request's neighbours as obstacles (none: one object)."""
     pl, gr = req.planner, req.gripper
     _check_params(pl)
     geometry = GripperGeometry.of(gr)

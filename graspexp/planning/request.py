@@ -1,6 +1,7 @@
 """What every planner receives; the planner contract is pure: request in, ``PlanResult`` out."""
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -8,6 +9,20 @@ from graspexp.config import CostConfig, GripperConfig, PlannerConfig
 from graspexp.perception.observation import Observation
 from graspexp.planning.details import PaperDetails
 from graspexp.planning.grasp import Grasp
+
+
+@dataclass(frozen=True)
+class Neighbour:
+    """Another object in the scene of a clutter round (``mode=pile``/``packed``), as the planner sees it.
+
+    id : the object's body id in the round (its slot). name : the dataset's object name. points : (N, 3)
+    its model's surface cloud at its perceived pose, world frame, m. pose : (4, 4) its perceived world pose.
+    """
+
+    id: int
+    name: str
+    points: np.ndarray
+    pose: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -31,6 +46,8 @@ class PlanRequest:
         object ids, the target's id), when the trial rendered it (``perception.source=depth``, or a planner
         whose schema sets ``needs_observation``); None otherwise. ``points`` and ``object_pose`` are then
         the model placed at the registered pose (or the true one with ``perception.source=truth``).
+    neighbours : the other objects on the support in a clutter round (empty for one object): obstacles
+        for the paths and the swept gripper; a planner that ignores them still plans for the target.
     """
 
     points: np.ndarray
@@ -45,6 +62,14 @@ class PlanRequest:
     seed: int
     support_blocks_gripper: bool = True
     observation: Observation | None = None
+    neighbours: tuple[Neighbour, ...] = ()
+
+    @cached_property
+    def neighbour_points(self) -> np.ndarray:
+        """(N, 3) every neighbour's cloud stacked, world m (empty (0, 3) without neighbours)."""
+        if not self.neighbours:
+            return np.zeros((0, 3))
+        return np.concatenate([np.asarray(n.points, dtype=np.float64) for n in self.neighbours])
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,7 @@ from graspexp.record.reader import (
     TrialLog,
     iter_trial_logs,
     read_result,
+    read_round,
     read_trial,
 )
 from graspexp.record.writer import TrialRecorder, TrialWriter, trial_recorder
@@ -25,6 +26,7 @@ __all__ = [
     "TrialWriter",
     "iter_trial_logs",
     "read_result",
+    "read_round",
     "read_trial",
     "trial_recorder",
 ]

@@ -20,11 +20,13 @@ BODY_NAMES: tuple[str, ...] = (OBJECT_NAME, SUPPORT_NAME, GROUND_NAME, PALM_NAME
 class Channels:
     """Every channel of a trial log on one ``foxglove.Context`` (its sinks: an MCAP file, a live server)."""
 
-    def __init__(self, context: foxglove.Context):
+    def __init__(self, context: foxglove.Context, bodies: tuple[str, ...] = BODY_NAMES):
         self.context = context
+        self.bodies = bodies
+        """The /contacts body names, by index (a clutter round's have one per object)."""
         self.tf = FrameTransformsChannel(S.TOPIC_TF, context=context)
         self.contacts = PointCloudChannel(
-            S.TOPIC_CONTACTS, metadata={"bodies": ",".join(BODY_NAMES)}, context=context
+            S.TOPIC_CONTACTS, metadata={"bodies": ",".join(bodies)}, context=context
         )
         self.scene = SceneUpdateChannel(S.TOPIC_SCENE, context=context)
         self.grasp_pose = PoseInFrameChannel(S.TOPIC_GRASP_POSE, context=context)
@@ -36,9 +38,21 @@ class Channels:
                 context=context,
             )
             for topic, name in S.TOPIC_SCHEMAS.items()
-            if name in S.SCHEMAS and topic not in S.CAMERA_TOPICS
+            if name in S.SCHEMAS and topic not in S.CAMERA_TOPICS + S.LAZY_TOPICS
         }
         self._camera: CameraChannels | None = None
+
+    def lazy_json(self, topic: str) -> foxglove.Channel:
+        """The JSON channel of one of :data:`graspexp.record.schemas.LAZY_TOPICS`, created on first use."""
+        if topic not in self.json:
+            name = S.TOPIC_SCHEMAS[topic]
+            self.json[topic] = foxglove.Channel(
+                topic,
+                schema=foxglove.Schema(name=name, encoding=S.SCHEMA_ENCODING, data=S.schema_bytes(name)),
+                message_encoding=S.MESSAGE_ENCODING,
+                context=self.context,
+            )
+        return self.json[topic]
 
     @property
     def camera(self) -> "CameraChannels":

@@ -81,6 +81,11 @@ class TrialLog:
     perception: dict | None = None
     """The /perception message (graspexp.Perception@1) of a trial that rendered the camera, its poses as
     (4, 4) ndarrays; None otherwise."""
+    round_result: dict | None = None
+    """The /round message (graspexp.RoundResult@1) of a clutter round's log, NaN restored; None otherwise.
+    Its ``grasp`` is the last attempt's (every attempt's /grasp is in ``grasps``)."""
+    grasps: list[dict] = field(default_factory=list)
+    """Every /grasp message in time order (a clutter round plans one per attempt)."""
 
 
 def _name(source: Any) -> str:
@@ -132,8 +137,10 @@ def _records(data: bytes, name: str) -> list:
     return records
 
 
-def _result_message(data: bytes, name: str) -> tuple[Channel, str, Message] | None:
-    """The last /result message, its channel and schema name, reading only the chunks that hold /result.
+def _result_message(
+    data: bytes, name: str, topic: str = S.TOPIC_RESULT
+) -> tuple[Channel, str, Message] | None:
+    """The last message on ``topic`` (/result, or a round log's /round), its channel and schema name, reading only the chunks that hold /result.
 
     The mcap library parses the footer, the summary and those chunks (their CRCs); the data-section CRC in the
     DataEnd record before the summary, which its seeking reader does not check, and the summary CRC are
@@ -162,7 +169,7 @@ def _result_message(data: bytes, name: str) -> tuple[Channel, str, Message] | No
         if data_end.data_section_crc and zlib.crc32(data[:data_end_at]) != data_end.data_section_crc:
             raise CorruptLogError(f"{name}: corrupt MCAP file (data section CRC mismatch)")
         reader = SeekingReader(io.BytesIO(data), validate_crcs=True, record_size_limit=len(data))
-        found = list(reader.iter_messages(topics=[S.TOPIC_RESULT]))
+        found = list(reader.iter_messages(topics=[topic]))
     except CorruptLogError:
         raise
     except Exception as exc:  # any parse failure of the bytes means a malformed file
@@ -359,10 +366,15 @@ def read_trial(source: Path | str | IO[bytes], *, require_result: bool = True) -
                 grasp["approach"] = np.array([_nan(v) for v in grasp["approach"]], dtype=float)
                 grasp["t_s"] = t_s
                 log.grasp = grasp
+                log.grasps.append(grasp)
             elif topic == S.TOPIC_RESULT:
                 if not isinstance(msg, dict) or "success" not in msg:
                     raise ValueError("result lacks 'success'")
                 log.result = msg
+            elif topic == S.TOPIC_ROUND:
+                if not isinstance(msg, dict) or "attempts" not in msg:
+                    raise ValueError("round result lacks 'attempts'")
+                log.round_result = msg
             elif topic == S.TOPIC_PERCEPTION:
                 log.perception = {
                     k: np.array(v, dtype=float) if k.endswith("_pose") else v
@@ -380,7 +392,7 @@ def read_trial(source: Path | str | IO[bytes], *, require_result: bool = True) -
     for frame, rows in tf.items():
         arr = np.asarray(rows, dtype=float).reshape(-1, 8)
         log.transforms[frame] = (arr[:, 0].copy(), arr[:, 1:4].copy(), arr[:, 4:8].copy())
-    if require_result and log.result is None:
+    if require_result and log.result is None and log.round_result is None:
         raise CorruptLogError(f"{name}: no /result message (the trial did not finish)")
     return log
 
@@ -404,6 +416,25 @@ def read_result(path: Path | str) -> dict:
         raise CorruptLogError(f"{name}: unreadable JSON on /result ({exc})") from exc
     if not isinstance(result, dict) or "success" not in result:
         raise CorruptLogError(f"{name}: malformed {S.TRIAL_RESULT} message on /result")
+    return result
+
+
+def read_round(path: Path | str) -> dict:
+    """Only the /round message of a clutter round's log (``RoundResult.to_dict()``, NaN restored), as
+    :func:`read_result` reads /result."""
+    name = str(path)
+    found = _result_message(_read_bytes(path, name), name, S.TOPIC_ROUND)
+    if found is None:
+        raise CorruptLogError(f"{name}: no /round message (the round did not finish)")
+    channel, schema_name, message = found
+    if schema_name != S.ROUND_RESULT or channel.message_encoding != S.MESSAGE_ENCODING:
+        raise CorruptLogError(f"{name}: /round has schema {schema_name!r}, expected {S.ROUND_RESULT!r}")
+    try:
+        result = S.restore_nan(json.loads(message.data), S.SCHEMAS[S.ROUND_RESULT])
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise CorruptLogError(f"{name}: unreadable JSON on /round ({exc})") from exc
+    if not isinstance(result, dict):
+        raise CorruptLogError(f"{name}: malformed {S.ROUND_RESULT} message on /round")
     return result
 
 

@@ -24,8 +24,9 @@ from foxglove.messages import (
 )
 
 from graspexp.config import JobConfig
-from graspexp.core.bodies import FINGER_NAMES, OBJECT_NAME, PALM_NAME, SUPPORT_NAME
+from graspexp.core.bodies import FINGER_NAMES, OBJECT_NAME, PALM_NAME, SUPPORT_NAME, TRAY_NAME, clutter_body
 from graspexp.grippers import LEFT, PALM, RIGHT, GripperGeometry, HandMeshes
+from graspexp.record.channels import BODY_NAMES
 from graspexp.sim.collision_shapes import hull_meshes
 
 SCENE_DECIMALS = 6
@@ -121,22 +122,59 @@ class ObjectScene:
     """The palm and finger boxes (a URDF gripper: its collision meshes), each in its own link frame."""
 
 
+@dataclass(frozen=True)
+class RoundScene(ObjectScene):
+    """The scene entities of a clutter round: the support, every object's hulls in its own frame
+    (``object_<slot>``), the gripper."""
+
+    bodies: dict[str, list[str]]
+    """Body name -> the ids of its entities (deleted when the object is taken away)."""
+
+
+def round_bodies(n_objects: int) -> tuple[str, ...]:
+    """The /contacts body names of a round of ``n_objects``: the single-object log's, the tray, then
+    ``object_0`` ... (the first, ``object``, is unused in a round)."""
+    return (*BODY_NAMES, TRAY_NAME, *(clutter_body(i) for i in range(n_objects)))
+
+
+def round_scene(cfg: JobConfig, hulls: list) -> RoundScene:
+    """Scene entities of a round under ``cfg`` whose object ``slot`` has the collision shape ``hulls[slot]``
+    (:class:`graspexp.sim.shape.CollisionShape`, object frame, m)."""
+    static, bodies = [_support_entity(cfg)], {}
+    for slot, parts in enumerate(hulls):
+        name = clutter_body(slot)
+        meshes = hull_meshes(parts)
+        ids = [f"{name}_hull_{i}" for i in range(len(meshes))]
+        for i, m in zip(ids, meshes, strict=True):
+            static.append(mesh_entity(i, name, m.vertices, m.faces, HULL_COLOR))
+        bodies[name] = ids
+    return RoundScene(static=static, gripper=_gripper_entities(cfg), bodies=bodies)
+
+
 def object_scene(cfg: JobConfig, hulls: list[np.ndarray]) -> ObjectScene:
     """Scene entities of one object under ``cfg`` (support size, gripper geometry); hulls : (V_i, 3) object frame, m."""
-    h = cfg.mode.support_height_m
-    hx, hy = cfg.mode.support_half_size_m
-    static = [box_entity(SUPPORT_NAME, "world", [0.0, 0.0, h / 2], [2 * hx, 2 * hy, h], SUPPORT_COLOR)]
+    static = [_support_entity(cfg)]
     for i, m in enumerate(hull_meshes(hulls)):
         static.append(mesh_entity(f"{OBJECT_NAME}_hull_{i}", OBJECT_NAME, m.vertices, m.faces, HULL_COLOR))
+    return ObjectScene(static=static, gripper=_gripper_entities(cfg))
+
+
+def _support_entity(cfg: JobConfig) -> SceneEntity:
+    h = cfg.mode.support_height_m
+    hx, hy = cfg.mode.support_half_size_m
+    return box_entity(SUPPORT_NAME, "world", [0.0, 0.0, h / 2], [2 * hx, 2 * hy, h], SUPPORT_COLOR)
+
+
+def _gripper_entities(cfg: JobConfig) -> list[SceneEntity]:
     geometry = GripperGeometry.of(cfg.gripper)
     if geometry.hand is not None:
-        return ObjectScene(static=static, gripper=hand_entities(geometry.hand))
+        return hand_entities(geometry.hand)
     palm = geometry.palm()
     gripper = [box_entity(PALM_NAME, PALM_NAME, list(palm.center), list(palm.size), GRIPPER_COLOR)]
     for name, sign in zip(FINGER_NAMES, (1.0, -1.0), strict=True):
         finger = geometry.finger(sign)
         gripper.append(box_entity(name, name, list(finger.center), list(finger.size), GRIPPER_COLOR))
-    return ObjectScene(static=static, gripper=gripper)
+    return gripper
 
 
 def hand_entities(hand: HandMeshes) -> list[SceneEntity]:

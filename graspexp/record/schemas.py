@@ -18,6 +18,7 @@ import math
 import types
 import typing
 
+from graspexp.core.clutter import AttemptResult, RoundResult
 from graspexp.core.outcome import TrialResult
 
 SCHEMA_ENCODING = "jsonschema"
@@ -36,6 +37,7 @@ PERCEPTION = "graspexp.Perception@1"
 PLANNED_GRASP = "graspexp.PlannedGrasp@1"
 PHASE = "graspexp.Phase@1"
 TRIAL_RESULT = "graspexp.TrialResult@4"
+ROUND_RESULT = "graspexp.RoundResult@1"
 READABLE_RESULTS = (TRIAL_RESULT, "graspexp.TrialResult@3", "graspexp.TrialResult@2")
 """/result schemas the readers accept: @3 is @4 without the pose-registration fields (then NaN: no pose
 was registered), @2 is @3 without ``at_rest`` (then True: the cap was not checked)."""
@@ -52,6 +54,10 @@ TOPIC_IDS = "/camera/ids"
 TOPIC_CALIBRATION = "/camera/calibration"
 TOPIC_CLOUD = "/camera/cloud"
 TOPIC_PERCEPTION = "/perception"
+TOPIC_ROUND = "/round"
+"""A clutter round's log (``mode=pile``/``packed``): its :class:`graspexp.core.clutter.RoundResult` with every
+attempt, in place of ``/result`` (created on first use: a trial's log has none)."""
+LAZY_TOPICS = (TOPIC_ROUND,)
 CAMERA_TOPICS = (TOPIC_DEPTH, TOPIC_IDS, TOPIC_CALIBRATION, TOPIC_CLOUD, TOPIC_PERCEPTION)
 """Topics of a trial that rendered the depth camera (created on first use: other logs lack them).
 ``/camera/depth`` (32FC1, m, 0 = no return) and ``/camera/ids`` (16UC1 object ids) are one
@@ -74,6 +80,7 @@ TOPIC_SCHEMAS: dict[str, str] = {
     TOPIC_CALIBRATION: CAMERA_CALIBRATION,
     TOPIC_CLOUD: POINT_CLOUD,
     TOPIC_PERCEPTION: PERCEPTION,
+    TOPIC_ROUND: ROUND_RESULT,
 }
 """Topic -> schema name, one channel per topic."""
 
@@ -93,6 +100,10 @@ PHASE_NAMES = (
     "done",
     "quality",
     "failed",
+    "remove_tray",
+    "taken_away",
+    "attempt_end",
+    "round_end",
 )
 """The phase names the trial protocol uses (the Phase schema accepts any string)."""
 
@@ -250,17 +261,34 @@ def _annotation_schema(tp: object) -> dict:
     raise TypeError(f"TrialResult field type {tp!r} has no JSON Schema mapping in graspexp.record.schemas")
 
 
-def _trial_result() -> dict:
-    hints = typing.get_type_hints(TrialResult)
-    fields = dataclasses.fields(TrialResult)
-    return {
-        "$schema": "https://json-schema.org/draft/2020-12/schema",
-        "title": TRIAL_RESULT,
-        "description": "graspexp.core.outcome.TrialResult.to_dict(); NaN floats are encoded as null.",
+def _dataclass_schema(cls: type, title: str | None = None, given: dict | None = None) -> dict:
+    """JSON Schema of a result dataclass's ``to_dict()`` (every field required); ``given``: field -> schema
+    for the fields whose annotation says too little."""
+    hints = typing.get_type_hints(cls)
+    fields = dataclasses.fields(cls)
+    given = given or {}
+    out = {
         "type": "object",
-        "properties": {f.name: _annotation_schema(hints[f.name]) for f in fields},
+        "properties": {f.name: given.get(f.name) or _annotation_schema(hints[f.name]) for f in fields},
         "required": [f.name for f in fields],
     }
+    if title is None:
+        return out
+    return {
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": title,
+        "description": f"{cls.__module__}.{cls.__name__}.to_dict(); NaN floats are encoded as null.",
+        **out,
+    }
+
+
+def _trial_result() -> dict:
+    return _dataclass_schema(TrialResult, TRIAL_RESULT)
+
+
+def _round_result() -> dict:
+    attempts = {"type": "array", "items": _dataclass_schema(AttemptResult)}
+    return _dataclass_schema(RoundResult, ROUND_RESULT, {"attempts": attempts})
 
 
 SCHEMAS: dict[str, dict] = {
@@ -268,6 +296,7 @@ SCHEMAS: dict[str, dict] = {
     PHASE: _phase(),
     TRIAL_RESULT: _trial_result(),
     PERCEPTION: _perception(),
+    ROUND_RESULT: _round_result(),
 }
 """Our own schema name -> JSON Schema document (the Foxglove topics carry protobuf schemas from the SDK)."""
 

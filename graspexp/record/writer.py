@@ -121,11 +121,11 @@ def to_json_value(value: Any) -> Any:
 
 
 @functools.cache
-def _body_ids() -> dict[str, int]:
-    return {name: i for i, name in enumerate(BODY_NAMES)}
+def _body_ids(bodies: tuple[str, ...] = BODY_NAMES) -> dict[str, int]:
+    return {name: i for i, name in enumerate(bodies)}
 
 
-def _contact_point(c: Mapping[str, Any]) -> bytes:
+def _contact_point(c: Mapping[str, Any], bodies: tuple[str, ...] = BODY_NAMES) -> bytes:
     """One /contacts point (see :data:`graspexp.record.schemas.CONTACT_FLOATS`) from a contact mapping."""
     position = [float(v) for v in c["position"]]
     normal = [float(v) for v in c["normal"]]
@@ -138,11 +138,11 @@ def _contact_point(c: Mapping[str, Any]) -> bytes:
     if not len(position) == len(normal) == len(force) == 3:
         raise ValueError(f"contact position, normal and force_n must have 3 components, got {dict(c)!r}")
     try:
-        ids = _body_ids()
-        bodies = ids[c["body0"]], ids[c["body1"]]
+        ids = _body_ids(bodies)
+        pair = ids[c["body0"]], ids[c["body1"]]
     except KeyError as exc:
-        raise ValueError(f"contact body {exc.args[0]!r} is not one of {BODY_NAMES}") from None
-    return _CONTACT.pack(*position, *normal, *force, float(c.get("separation_m", 0.0)), *bodies)
+        raise ValueError(f"contact body {exc.args[0]!r} is not one of {bodies}") from None
+    return _CONTACT.pack(*position, *normal, *force, float(c.get("separation_m", 0.0)), *pair)
 
 
 def _raw_image(ts: Timestamp, frame_id: str, pixels: np.ndarray, encoding: str) -> RawImage:
@@ -168,19 +168,25 @@ class TrialWriter:
 
     metadata : str -> str, stored as the MCAP metadata record named ``graspexp``. ``channels``: the
     channels of a live server (:func:`graspexp.record.live.live_channels`) that also get every message;
-    None: the file only. ``stream=None`` with live channels streams without writing a file.
+    None: the file only. ``stream=None`` with live channels streams without writing a file. ``bodies``: the
+    /contacts body names (a clutter round's: :func:`graspexp.record.scene.round_bodies`).
     """
 
     active = True
     """Every message is kept (:class:`graspexp.sim.trial.LogSink`)."""
 
     def __init__(
-        self, stream: IO[bytes] | None, metadata: Mapping[str, str], channels: Channels | None = None
+        self,
+        stream: IO[bytes] | None,
+        metadata: Mapping[str, str],
+        channels: Channels | None = None,
+        bodies: tuple[str, ...] = BODY_NAMES,
     ):
         bad = [k for k, v in metadata.items() if not isinstance(k, str) or not isinstance(v, str)]
         if bad:
             raise TypeError(f"metadata must map str to str; offending keys: {bad}")
-        self._ch = channels if channels is not None else Channels(foxglove.Context())
+        self._ch = channels if channels is not None else Channels(foxglove.Context(), bodies)
+        self._bodies = self._ch.bodies
         self._mcap = None
         if stream is not None:
             options = MCAPWriteOptions(
@@ -258,7 +264,7 @@ class TrialWriter:
             pose=_IDENTITY,
             point_stride=S.CONTACT_STRIDE,
             fields=_CONTACT_FIELDS,
-            data=b"".join(_contact_point(c) for c in contacts),
+            data=b"".join(_contact_point(c, self._bodies) for c in contacts),
         )
         self._ch.contacts.log(cloud, log_time=ns)
 
@@ -315,6 +321,19 @@ class TrialWriter:
         if self._mcap is not None:
             self._mcap.flush()  # the result gets a chunk of its own: read_result decompresses only that
         self._json(S.TOPIC_RESULT, t_s, to_json_value(d))
+        self._has_result = True
+
+    def round_result(self, t_s: float, result: Mapping[str, Any] | Any) -> None:
+        """/round, graspexp.RoundResult@1: a clutter round's ``RoundResult.to_dict()``, its attempts included
+        (the round log's last message, in place of /result)."""
+        d = result.to_dict() if hasattr(result, "to_dict") else dict(result)
+        missing = [k for k in S.SCHEMAS[S.ROUND_RESULT]["required"] if k not in d]
+        if missing:
+            raise ValueError(f"round result lacks fields {missing}")
+        if self._mcap is not None:
+            self._mcap.flush()
+        channel = self._ch.lazy_json(S.TOPIC_ROUND)
+        channel.log(_dumps(to_json_value(d)), log_time=self._ns(t_s))
         self._has_result = True
 
     def perception(
@@ -412,7 +431,13 @@ class TrialRecorder(TrialWriter):
     RuntimeError from :meth:`close`).
     """
 
-    def __init__(self, path: Path | str, metadata: Mapping[str, str], channels: Channels | None = None):
+    def __init__(
+        self,
+        path: Path | str,
+        metadata: Mapping[str, str],
+        channels: Channels | None = None,
+        bodies: tuple[str, ...] = BODY_NAMES,
+    ):
         self.path = Path(path)
         self.partial_path = self.path.with_name(self.path.name + PARTIAL_SUFFIX)
         self.path.parent.mkdir(parents=True, exist_ok=True)
@@ -421,7 +446,7 @@ class TrialRecorder(TrialWriter):
         flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW  # a link planted meanwhile: refused
         self._file = os.fdopen(os.open(self.partial_path, flags, 0o644), "wb")  # closed by close() or abort()
         try:
-            super().__init__(self._file, metadata, channels)
+            super().__init__(self._file, metadata, channels, bodies)
         except BaseException:
             self.abort()
             raise
@@ -432,7 +457,9 @@ class TrialRecorder(TrialWriter):
             return
         if not self.has_result:
             self.abort()
-            raise RuntimeError(f"{self.path}: trial log closed without a /result message; log discarded")
+            raise RuntimeError(
+                f"{self.path}: trial log closed without a /result (or /round) message; log discarded"
+            )
         try:
             self.finish()
             self._file.close()
@@ -468,7 +495,10 @@ class TrialRecorder(TrialWriter):
 
 
 def trial_recorder(
-    path: Path | str | None, metadata: Mapping[str, str], cfg: "JobConfig"
+    path: Path | str | None,
+    metadata: Mapping[str, str],
+    cfg: "JobConfig",
+    bodies: tuple[str, ...] = BODY_NAMES,
 ) -> AbstractContextManager:
     """The recorder of one trial under job config ``cfg`` (its ``live`` and ``live_port`` keys).
 
@@ -479,9 +509,9 @@ def trial_recorder(
     if cfg.live:
         channels = live_channels(int(cfg.live_port))
     if path is not None:
-        return TrialRecorder(path, metadata, channels)
+        return TrialRecorder(path, metadata, channels, bodies)
     if channels is not None:
-        return TrialWriter(None, metadata, channels)
+        return TrialWriter(None, metadata, channels, bodies)
     from graspexp.sim.trial import NullRecorder
 
     return nullcontext(NullRecorder())

@@ -13,15 +13,17 @@ Output files (in ``<dir>/report/`` unless told otherwise)::
     unreadable.csv                   logs that could not be read (path, reason), if any
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
 
+from graspexp.core.clutter import RoundResult
 from graspexp.record import CorruptLogError, read_trial
 from graspexp.report.agreement import Agreement, agreement, agreement_chart, example_trials
 from graspexp.report.charts import success_chart
 from graspexp.report.citations import DETERMINISM
+from graspexp.report.clutter import clutter_markdown, clutter_table, find_rounds
 from graspexp.report.collect import FINGERPRINT_COLUMN, Collected, collect
 from graspexp.report.contact_area import held_in_area
 from graspexp.report.gallery import draw_trial, write_gallery
@@ -50,6 +52,8 @@ class Report:
     """Success by the paper's criterion beside the stricter slip criterion and in the area, per setting."""
     agreements: list[Agreement]
     """Per object agreement with the paper, one per table that reproduces a paper table."""
+    rounds: list[RoundResult] = field(default_factory=list)
+    """The clutter-removal rounds below the directory (``mode=pile``/``packed``)."""
 
 
 def build_report(root: Path | str, progress: bool = True) -> Report:
@@ -57,13 +61,16 @@ def build_report(root: Path | str, progress: bool = True) -> Report:
     logs are read again for the in-area criterion (``progress``: a progress bar on stderr)."""
     col = collect(root)
     df = col.results
+    rounds = find_rounds(root)
     if df.empty:
-        return Report(col, [], pd.DataFrame(), pd.DataFrame(), pd.DataFrame(), [])
+        return Report(col, [], pd.DataFrame(), pd.DataFrame(), pd.DataFrame(), [], rounds)
     df[IN_AREA_COLUMN] = held_in_area(df, progress)
     tables = success_tables(df)
     agreements = [a for a in map(agreement, tables) if a is not None]
     outcomes = pd.concat([df, col.not_run], ignore_index=True)  # counts: the not-run trials as `error`
-    return Report(col, tables, failure_breakdown(outcomes), runtime_table(df), strict_table(df), agreements)
+    return Report(
+        col, tables, failure_breakdown(outcomes), runtime_table(df), strict_table(df), agreements, rounds
+    )
 
 
 def _runtime_display(rt: pd.DataFrame) -> pd.DataFrame:
@@ -170,6 +177,23 @@ def agreement_section(ag: Agreement, results: pd.DataFrame, out: Path) -> list[s
     ]
 
 
+def clutter_section(rounds: list[RoundResult], out: Path) -> list[str]:
+    """Write ``clutter.md``/``clutter.csv`` (:func:`graspexp.report.clutter.clutter_table`); the report's lines."""
+    text = clutter_markdown(rounds)
+    (out / "clutter.md").write_text(text + "\n")
+    clutter_table(rounds).to_csv(out / "clutter.csv", index=False)
+    return [
+        "## Clutter removal (mode=pile, mode=packed)",
+        "",
+        f"{len(rounds)} rounds. GSR = successful / executed grasp attempts, DR = objects removed / objects "
+        "placed (VGN, Breyer et al. CoRL 2020; GIGA, Jiang et al. RSS 2021), each with its Wilson 95 % "
+        "interval; planning latency per scene (every plan of an attempt), CPU and wall.",
+        "",
+        text,
+        "",
+    ]
+
+
 def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 2) -> str:
     """Write every file of the report into ``out_dir``; returns the Markdown of report.md.
 
@@ -199,6 +223,8 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
         md += ["", f"![{table.name}]({table.name}.png)", ""]
     for ag in report.agreements:
         md += agreement_section(ag, col.results, out)
+    if report.rounds:
+        md += clutter_section(report.rounds, out)
     if not report.failures.empty:
         (out / "failures.md").write_text(markdown(report.failures, index=False) + "\n")
         (out / "failures.tex").write_text(latex(report.failures, "Failure reasons per setting", index=False))

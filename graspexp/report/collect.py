@@ -21,7 +21,7 @@ from graspexp.config.differences import result_config
 from graspexp.core.outcome import FailureReason, TrialResult, result_from_dict
 from graspexp.core.run_layout import TRIALS_DIR, hydra_dir, results_tables, trials_dir
 from graspexp.core.userinput import load_user_yaml, read_user_yaml, shown
-from graspexp.record import CorruptLogError, read_result
+from graspexp.record import CorruptLogError, read_result, read_round
 from graspexp.record.reader import read_metadata
 from graspexp.record.writer import PARTIAL_SUFFIX
 
@@ -109,7 +109,8 @@ def _log_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
                 raise CorruptLogError(f"{path}: its recorded config is not a job config")
             result_from_dict(result)
         except (CorruptLogError, OSError, ValueError) as exc:
-            unreadable.append((path, str(exc) if str(path) in str(exc) else f"{path}: {exc}"))
+            if not _is_round_log(path):  # a clutter round's log is read by graspexp.report.clutter
+                unreadable.append((path, str(exc) if str(path) in str(exc) else f"{path}: {exc}"))
             continue
         row = _row(result, path, noise_of(config))
         row[CONFIG_COLUMN] = result_config(config)
@@ -117,6 +118,15 @@ def _log_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
         row[FINGERPRINT_COLUMN] = fingerprint(meta)
         rows.append(row)
     return rows, unreadable
+
+
+def _is_round_log(path: Path) -> bool:
+    """Whether ``path`` is a clutter round's complete log (a /round message in place of /result)."""
+    try:
+        read_round(path)
+    except (CorruptLogError, OSError):
+        return False
+    return True
 
 
 def _csv_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:

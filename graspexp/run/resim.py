@@ -8,7 +8,10 @@ import numpy as np
 from graspexp.config.errors import ConfigError
 from graspexp.config.registry import job_config_from_yaml
 from graspexp.datasets.catalog import DATA_ENV
+from graspexp.planning import plan
+from graspexp.quality import fc_min_mu
 from graspexp.run.objects import load_object, trial_context
+from graspexp.sim.clutter import RoundContext, RoundObject, run_round
 from graspexp.sim.trial import NullRecorder, plain_config, run_trial
 
 POSE_TOLERANCE = 1e-6
@@ -49,6 +52,8 @@ def resimulate(log) -> tuple[bool, str]:
     ):
         cfg.dataset.root = recorded_root  # the folder the trial read its mesh from, when no other is named
     plain = plain_config(cfg)
+    if log.round_result is not None:
+        return _resimulate_round(log, cfg, plain)
     name, trial, seed = meta["object"], int(meta["trial"]), int(meta["trial_seed"])
     loaded = load_object(cfg, name, plain)
     model, shape = loaded.model, loaded.hulls
@@ -72,6 +77,16 @@ def resimulate(log) -> tuple[bool, str]:
             f"outcome differs: logged success={logged.get('success')} reason={logged.get('reason')}, "
             f"re-simulated success={result.success} reason={result.reason}"
         )
+    problems += _pose_differences(log, capture)
+    if problems:
+        return False, "; ".join(problems)
+    n = sum(len(v[0]) for v in log.transforms.values())
+    return True, f"outcome ({'success' if result.success else result.reason}) and {n} logged poses reproduced"
+
+
+def _pose_differences(log, capture: _PoseCapture) -> list[str]:
+    """One line per logged frame whose re-simulated poses differ (count, or beyond :data:`POSE_TOLERANCE`)."""
+    problems = []
     for frame, (times, pos, quat) in log.transforms.items():
         sim = capture.samples.get(frame, [])
         if len(sim) != len(times):
@@ -81,7 +96,45 @@ def resimulate(log) -> tuple[bool, str]:
         err = np.abs(np.concatenate([pos, quat], axis=1) - ours).max() if len(sim) else 0.0
         if err > POSE_TOLERANCE:
             problems.append(f"frame {frame}: poses differ by up to {err:.3g}")
+    return problems
+
+
+def _resimulate_round(log, cfg, plain) -> tuple[bool, str]:
+    """:func:`resimulate` for a clutter round's log: the drawn objects (``round_objects``) placed again from
+    the round's seed; every attempt's target and outcome, the round's end and every logged pose compared."""
+    meta = log.metadata
+    names = str(meta.get("round_objects", "")).split()
+    if not names:
+        raise ConfigError("the round log's metadata lacks round_objects (the objects drawn for the round)")
+    loaded = [load_object(cfg, name, plain) for name in names]
+    capture = _PoseCapture()
+    ctx = RoundContext(
+        plain,
+        [RoundObject(o.model, o.hulls) for o in loaded],
+        int(meta["trial"]),
+        int(meta["trial_seed"]),
+        capture,
+        plan=plan,
+        quality=fc_min_mu,
+    )
+    result = run_round(ctx)
+    logged = log.round_result
+    problems = []
+    if (logged["end"], logged["removed"]) != (result.end, result.removed):
+        problems.append(
+            f"round differs: logged end={logged['end']} removed={logged['removed']}, re-simulated "
+            f"end={result.end} removed={result.removed}"
+        )
+    key = ("attempt", "target", "slot", "success", "reason")
+    ours = [tuple(a[k] for k in key) for a in result.attempts]
+    theirs = [tuple(a[k] for k in key) for a in logged["attempts"]]
+    if ours != theirs:
+        problems.append(f"attempts differ: logged {theirs}, re-simulated {ours}")
+    problems += _pose_differences(log, capture)
     if problems:
         return False, "; ".join(problems)
     n = sum(len(v[0]) for v in log.transforms.values())
-    return True, f"outcome ({'success' if result.success else result.reason}) and {n} logged poses reproduced"
+    return (
+        True,
+        f"round ({result.end}, {len(result.removed)}/{len(result.placed)} removed, {len(ours)} attempts) and {n} logged poses reproduced",
+    )

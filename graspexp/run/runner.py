@@ -18,6 +18,7 @@ from omegaconf import DictConfig, OmegaConf
 from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
+from graspexp.config.mode import CLUTTER_MODES
 from graspexp.core.outcome import TrialResult
 from graspexp.datasets import select_objects
 from graspexp.run.job_config import make_ready
@@ -25,6 +26,7 @@ from graspexp.run.objects import LoadedObject, load_models
 from graspexp.run.prepare import prepare_shapes
 from graspexp.run.provenance import write_hydra_record
 from graspexp.run.resume import check_resumable, check_run_files, check_same_meshes, job_lock, kept_results
+from graspexp.run.round_loop import timed_rounds
 from graspexp.run.summary import objective_value, write_summary
 from graspexp.run.trial_loop import run_object_trials
 
@@ -75,6 +77,8 @@ def _run_trials(
     wall0: float,
     cpu0: float,
 ) -> float:
+    if cfg.mode.name in CLUTTER_MODES:
+        return timed_rounds(cfg, run_dir, objects, models, wall0, cpu0)
     results: list[TrialResult] = []
     with tqdm(
         total=len(objects) * cfg.trials,

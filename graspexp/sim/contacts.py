@@ -30,15 +30,17 @@ def _touching(contact: sapien.physx.PhysxContact) -> bool:
     return False
 
 
-def finger_forces(contacts: list, dt: float, closing_axis: np.ndarray) -> dict[str, float]:
-    """Squeezing force of each finger on the object over the last step, N: the magnitude of the
-    finger-object contact force along the closing axis ((3,) unit, world). A finger resting on the
-    object's top, with its force along the approach, does not squeeze it."""
+def finger_forces(
+    contacts: list, dt: float, closing_axis: np.ndarray, target: str = OBJECT_NAME
+) -> dict[str, float]:
+    """Squeezing force of each finger on the object (the body named ``target``) over the last step, N: the
+    magnitude of the finger-object contact force along the closing axis ((3,) unit, world). A finger
+    resting on the object's top, with its force along the approach, does not squeeze it."""
     out = dict.fromkeys(FINGER_NAMES, 0.0)
     for c in contacts:
         a, b = _pair_names(c)
-        if OBJECT_NAME in (a, b):
-            other = b if a == OBJECT_NAME else a
+        if target in (a, b):
+            other = b if a == target else a
             if other in out:
                 impulse = np.sum([p.impulse for p in c.points], axis=0)
                 out[other] += abs(float(impulse @ closing_axis)) / dt
@@ -106,4 +108,17 @@ def contact_records(contacts: list, dt: float) -> list[dict]:
             }
         )
     out.sort(key=lambda r: (r["body0"], r["body1"]))
+    return out
+
+
+def gripper_touches(contacts: list, exclude: str) -> set[str]:
+    """Names of the bodies other than the gripper's links and ``exclude`` that a gripper link touches
+    (a clutter round's neighbours of the target ``exclude``, the support)."""
+    out = set()
+    for c in contacts:
+        a, b = _pair_names(c)
+        if (a in GRIPPER_LINKS) != (b in GRIPPER_LINKS):
+            other = b if a in GRIPPER_LINKS else a
+            if other != exclude and other not in out and _touching(c):
+                out.add(other)
     return out

@@ -87,6 +87,15 @@ def build_scene(
     if given (an object's sidecar), else ``sim.object_static_friction`` / ``sim.object_dynamic_friction``.
     In collab mode the support collides with the object only (paper IV-A); in bin mode also with the gripper.
     """
+    scene, support = base_scene(mode, sim)
+    entity, body = add_object(scene, shape, mass_kg, drop_pose, sim, friction, OBJECT_NAME, OBJECT_MASK)
+    h = float(mode.support_height_m)
+    return TrialScene(scene=scene, object_entity=entity, object_body=body, support=support, table_z=h)
+
+
+def base_scene(mode: ModeConfig, sim: SimConfig) -> tuple[sapien.Scene, sapien.Entity]:
+    """A new scene (PhysX configured from ``sim``) with the floor and the support (top at
+    ``mode.support_height_m``; collides with the gripper where ``mode.support_collides_with_gripper``)."""
     configure_physx(sim)
     scene = sapien.Scene([sapien.physx.PhysxCpuSystem()])
     scene.set_timestep(float(sim.timestep_s))
@@ -108,7 +117,27 @@ def build_scene(
     set_groups(
         support.find_component_by_type(sapien.physx.PhysxRigidStaticComponent), SUPPORT_BIT, support_mask
     )
+    return scene, support
 
+
+OBJECT_MASK = SUPPORT_BIT | GRIPPER_BIT | GROUND_BIT
+"""What a lone object collides with (collab, bin)."""
+CLUTTER_OBJECT_MASK = OBJECT_MASK | OBJECT_BIT
+"""What an object of a clutter round collides with: the others too."""
+
+
+def add_object(
+    scene: sapien.Scene,
+    shape: CollisionShape,
+    mass_kg: float,
+    pose: np.ndarray,
+    sim: SimConfig,
+    friction: float | None,
+    name: str,
+    mask: int,
+) -> tuple[sapien.Entity, sapien.physx.PhysxRigidDynamicComponent]:
+    """Add one dynamic object body named ``name`` at ``pose`` ((4,4), world, m) colliding with ``mask``
+    (:func:`build_scene` says what its shape, mass and friction are)."""
     static, dynamic = (
         (sim.object_static_friction, sim.object_dynamic_friction)
         if friction is None
@@ -125,14 +154,14 @@ def build_scene(
             f"{len(shape.parts)} collision parts"
         )
     entity = sapien.Entity()
-    entity.name = OBJECT_NAME
+    entity.name = name
     entity.add_component(body)
-    entity.pose = sapien.Pose(drop_pose[:3, 3], matrix_to_quat_wxyz(drop_pose[:3, :3]))
+    entity.pose = sapien.Pose(pose[:3, 3], matrix_to_quat_wxyz(pose[:3, :3]))
     scene.add_entity(entity)
     body.mass = float(mass_kg)
     body.angular_damping = float(sim.object_angular_damping)
-    set_groups(body, OBJECT_BIT, SUPPORT_BIT | GRIPPER_BIT | GROUND_BIT)
-    return TrialScene(scene=scene, object_entity=entity, object_body=body, support=support, table_z=h)
+    set_groups(body, OBJECT_BIT, mask)
+    return entity, body
 
 
 def _object_shapes(

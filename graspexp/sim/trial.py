@@ -61,6 +61,7 @@ class LogSink(Protocol):
     def grasp(self, t_s: float, grasp: Mapping[str, Any]) -> None: ...
     def phase(self, t_s: float, name: str, info: Mapping[str, Any] | None = None) -> None: ...
     def result(self, t_s: float, result: Mapping[str, Any]) -> None: ...
+    def round_result(self, t_s: float, result: Mapping[str, Any]) -> None: ...
     def perception(
         self, t_s: float, observation: Observation, poses: Mapping[str, np.ndarray], info: Mapping[str, Any]
     ) -> None: ...
@@ -91,6 +92,9 @@ class NullRecorder:
         pass
 
     def result(self, t_s: float, result: Mapping[str, Any]) -> None:
+        pass
+
+    def round_result(self, t_s: float, result: Mapping[str, Any]) -> None:
         pass
 
     def perception(
@@ -184,8 +188,8 @@ class _Sim:
         self._next_log = self.log_every if self.recording else -1
         self._physx_step = ts.scene.physx_system.step
         self._contacts = ts.scene.physx_system.get_contacts
-        body = ts.object_body
-        self._velocities = (body.get_linear_velocity, body.get_angular_velocity)
+        body = ts.object_body  # None in a clutter scene before its first object (clutter._RoundSim.track)
+        self._velocities = None if body is None else (body.get_linear_velocity, body.get_angular_velocity)
         self._last_velocities: tuple[np.ndarray, np.ndarray] | None = None
         self._surely_v = self.max_speed_sq * (1.0 - F32_DOT_REL_ERROR)
         self._surely_w = self.max_angular_speed_sq * (1.0 - F32_DOT_REL_ERROR)
@@ -499,7 +503,8 @@ def _force_closure_mu(ctx: TrialContext, sim: _Sim, grasp: Grasp) -> float:
 
 
 def _held(sim: _Sim, grasp: Grasp) -> dict[str, float]:
-    return finger_forces(sim.ts.scene.get_contacts(), sim.dt, grasp.pose[:3, 1])
+    target = sim.ts.object_entity.name
+    return finger_forces(sim.ts.scene.get_contacts(), sim.dt, grasp.pose[:3, 1], target)
 
 
 def _grasp_point_on_object(gripper: Gripper, ts: TrialScene) -> np.ndarray:

@@ -17,6 +17,7 @@ TOOLS: tuple[str, ...] = (
     "tune",
     "results",
     "bench.trials",
+    "bench.clutter",
     "bench.reproduce",
     "bench.plan_latency",
     "bench.collision_shapes",

@@ -85,7 +85,16 @@ def format_timeline(log: TrialLog) -> str:
             f"width={_fmt_num(g.get('width_m'), ' m')} cluster={g.get('cluster')} path={g.get('path')} "
             f"K={g.get('K')} M={g.get('M')} n_feasible={g.get('n_feasible')}"
         )
-    if log.result is None:
+    if log.round_result is not None:
+        rr = log.round_result
+        lines.append(
+            f"round: {rr['end']}, removed {len(rr['removed'])} of {len(rr['placed'])} placed "
+            f"({' '.join(rr['drawn'])} drawn)"
+        )
+        for a in rr["attempts"]:
+            status = "ok" if a["success"] else a["reason"]
+            lines.append(f"  attempt {a['attempt']}: {a['target']} (object_{a['slot']}) {status}")
+    elif log.result is None:
         lines.append("outcome: (no result)")
     else:
         status = "SUCCESS" if res.get("success") else f"FAILED ({res.get('reason')})"

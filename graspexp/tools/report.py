@@ -33,7 +33,8 @@ def main(argv: list[str] | None = None) -> int:
         report = build_report(args.dir)
     except MixedConfigError as exc:
         return _error(str(exc))
-    if report.collected.results.empty and not report.collected.unreadable and report.collected.not_run.empty:
+    col = report.collected
+    if col.results.empty and not col.unreadable and col.not_run.empty and not report.rounds:
         return _error(f"no trial logs (trials/*/*.mcap) below {args.dir}")
     out = args.out if args.out is not None else args.dir / "report"
     try:
@@ -43,7 +44,7 @@ def main(argv: list[str] | None = None) -> int:
             f"cannot write the report to {out}: {exc.strerror or exc}; choose another folder with --out"
         )
     print(f"\nreport written to {out}", file=sys.stderr)
-    if report.collected.results.empty and not report.collected.not_run.empty:
+    if report.collected.results.empty and not report.collected.not_run.empty and not report.rounds:
         print(
             f"graspexp report: no trial below {args.dir} ran to an outcome (every one is listed as not run)",
             file=sys.stderr,

@@ -108,7 +108,7 @@ def test_out_of_range_values_name_the_key(override, message):
     [
         (
             ["mode=foo"],
-            "graspexp: error: In 'config': Could not find 'mode/foo'; Available options in 'mode': bin, collab",
+            "graspexp: error: In 'config': Could not find 'mode/foo'; Available options in 'mode': bin, collab, packed, pile",
         ),
         (["mode.nme=3"], "graspexp: error: Could not override 'mode.nme'. Key 'nme' not in 'ModeConfig'"),
         (

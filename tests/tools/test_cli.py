@@ -101,5 +101,5 @@ def test_a_tool_with_a_bad_override_is_one_line(capsys):
         main(["objects=[mug]", "mode=foo"])
     assert done.value.code == 2
     assert capsys.readouterr().err == (
-        "graspexp plan: error: In 'config': Could not find 'mode/foo'; Available options in 'mode': bin, collab\n"
+        "graspexp plan: error: In 'config': Could not find 'mode/foo'; Available options in 'mode': bin, collab, packed, pile\n"
     )

@@ -30,6 +30,19 @@ class PaperPathsConfig(PlannerConfig):
     table_clearance_m: float = 0.0
     """A path is dropped when its sphere point lies below the support plane plus this, m; 0 = III-D's
     "paths that will pass through the desktop" taken at the path's start point."""
+    neighbour_voxel_m: float = 0.01
+    """Clutter rounds (``mode=pile``/``packed``): a path passes through another object (and is dropped, as
+    III-D drops "paths that will pass through the desktop") when a point sampled every half voxel along it,
+    from the sphere point to the cluster radius r_k from the centre (nearer, the fingers close about the
+    target: the swept check judges that part), falls in a cube of this side, m, that holds a point of
+    that object's cloud. 1 cm: wider than the spacing of a sampled cloud (about 5 mm on a 10 cm object
+    with 1024 points), so no path slips between the points of a surface it crosses; no effect on one object."""
+    neighbour_fallback: bool = True
+    """Clutter rounds: when the swept gripper of every path meets a neighbour, ``optimal`` takes the cheapest
+    path clear of the target and the support, ``optimal_plus`` the grasp it plans for the target alone
+    (``extras["touches_neighbours"]``), instead of finding no grasp. The protocol lets the gripper touch
+    the other objects (VGN executes with ``allow_contact=True``); in a heap, a palm 15 cm wide meets a
+    neighbour on nearly every path. No effect on one object."""
     seed: int = 0
     """Seed of the K-means initialisation (combined with the trial seed)."""
     main_axis: str = "object"
@@ -74,6 +87,8 @@ PAPER_PATHS_CONSTRAINTS = {
     "k_max": [Interval(1, 64, integer=True)],
     "m": [Interval(1, 100_000, integer=True)],
     "table_clearance_m": [Interval(-1, 1, unit="m")],
+    "neighbour_voxel_m": [Interval(0, 1, "right", unit="m")],
+    "neighbour_fallback": BOOL,
     "seed": [Interval(0, None, integer=True)],
     "main_axis": [Options(("object", "area"))],
     "pose_axis": [Options(("object", "area", "area_if_elongated"))],

@@ -1,0 +1,123 @@
+"""A clutter-removal round's outcome (``mode=pile``/``packed``): one row per grasp attempt, one per round.
+
+GSR (grasp success rate) = successful attempts / executed attempts; DR (declutter rate, VGN's "percent
+cleared") = objects removed / objects placed (Breyer et al., CoRL 2020; Jiang et al., RSS 2021).
+"""
+
+import enum
+from dataclasses import asdict, dataclass, field
+
+
+class RoundEnd(str, enum.Enum):
+    """Why a round ended (VGN's three rules, and an error)."""
+
+    CLEARED = "cleared"
+    """No object is left on the table."""
+    NO_GRASP = "no_grasp"
+    """The planner found no grasp on any object left."""
+    FAILURE_LIMIT = "failure_limit"
+    """``mode.max_consecutive_failures`` attempts in a row failed."""
+    ERROR = "error"
+    """The round raised; the message is in ``RoundResult.error``."""
+
+
+@dataclass
+class AttemptResult:
+    """One grasp attempt of a round (a row of ``attempts.csv``)."""
+
+    round: int
+    attempt: int
+    target: str
+    """Name of the object the attempt grasped (the dataset's object name)."""
+    slot: int
+    """Index of the target among the round's drawn objects (its body is ``object_<slot>``)."""
+    executed: bool
+    """False for the round's last row when no grasp was found (``reason`` no_feasible_grasp): not an attempt
+    of GSR's denominator."""
+    success: bool
+    reason: str | None
+    """A :class:`graspexp.core.outcome.FailureReason` value, None on success."""
+    pick_order: str
+    """``mode.pick_order`` that chose the target."""
+    n_left: int
+    """Objects on the table before the attempt."""
+    n_planned: int
+    """Plans made for this attempt (objects planned for)."""
+    plan_s: float
+    """Wall time of every plan made for the attempt (the scene's planning latency), s."""
+    plan_cpu_s: float
+    """CPU time of the planning thread over the same plans, s."""
+    grasp_cost: float = float("nan")
+    grasp_width_m: float = float("nan")
+    n_feasible: int = 0
+    slip_m: float = float("nan")
+    touched_support: bool = False
+    touched_neighbours: list[str] = field(default_factory=list)
+    """Bodies (``object_<slot>``) other than the target that the gripper touched during the attempt (allowed)."""
+    moved_neighbours: list[str] = field(default_factory=list)
+    """Bodies other than the target that ended more than ``MOVED_M`` from where they were before it."""
+    execute_s: float = 0.0
+    """Wall time of the attempt's execution (approach to hold) and the settling after it, s."""
+    sim_time_s: float = 0.0
+    """Sim time of the round when the attempt ended, s."""
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass
+class RoundResult:
+    """One round: what was drawn, what was placed, how it ended (a row of ``rounds.csv``; also the round
+    log's ``/round`` message, ``graspexp.RoundResult@1``)."""
+
+    dataset: str
+    mode: str
+    planner: str
+    round: int
+    seed: int
+    drawn: list[str]
+    """The objects drawn for the round, by slot."""
+    placed: list[str]
+    """Slots (``object_<slot>``) on the table inside the workspace once the scene settled."""
+    removed: list[str]
+    """Slots removed by a successful grasp."""
+    end: str
+    """A :class:`RoundEnd` value."""
+    attempts: list[dict] = field(default_factory=list)
+    """Every :class:`AttemptResult` of the round, as dicts."""
+    error: str = ""
+    wall_s: float = 0.0
+    cpu_s: float = 0.0
+    sim_time_s: float = 0.0
+
+    @property
+    def n_placed(self) -> int:
+        return len(self.placed)
+
+    @property
+    def n_removed(self) -> int:
+        return len(self.removed)
+
+    def attempt_rows(self) -> list[AttemptResult]:
+        return [AttemptResult(**a) for a in self.attempts]
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: object) -> "RoundResult":
+        """Read back a ``/round`` message (or a dict of one); ValueError naming what is wrong."""
+        if not isinstance(d, dict):
+            raise ValueError(f"a round result is a mapping, got {type(d).__name__}")
+        missing = [k for k in ("round", "drawn", "placed", "removed", "end", "attempts") if k not in d]
+        if missing:
+            raise ValueError(f"round result lacks {missing}")
+        if d["end"] not in {e.value for e in RoundEnd}:
+            raise ValueError(f"round result end={d['end']!r} is not one of {[e.value for e in RoundEnd]}")
+        known = set(cls.__dataclass_fields__)
+        out = cls(**{k: v for k, v in d.items() if k in known})
+        try:
+            out.attempt_rows()
+        except TypeError as exc:
+            raise ValueError(f"round result has a malformed attempt ({exc})") from None
+        return out

@@ -1,0 +1,160 @@
+"""Clutter removal (``mode=pile``/``packed``) in tables: per planner and scene, the grasp success rate (GSR =
+successful / executed attempts) and the declutter rate (DR = objects removed / objects placed), each with
+its Wilson 95 % interval, attempts per round, how rounds ended, the failure reason of every failed attempt
+and the planning latency per scene (p50/p95, CPU and wall). The metrics are VGN's (Breyer et al., CoRL
+2020: "success rate" and "percent cleared") and GIGA's (Jiang et al., RSS 2021)."""
+
+from collections.abc import Iterable
+from pathlib import Path
+
+import pandas as pd
+
+from graspexp.config.mode import CLUTTER_MODES
+from graspexp.core.clutter import RoundEnd, RoundResult
+from graspexp.core.run_layout import TRIALS_DIR
+from graspexp.record import CorruptLogError, iter_trial_logs, read_round
+from graspexp.report.stats import percentiles, success_pct
+
+ROUNDS_CSV = "rounds.csv"
+ATTEMPTS_CSV = "attempts.csv"
+"""A clutter run's tables beside its logs: one row per round, one per attempt."""
+
+
+def rounds_frame(rounds: Iterable[RoundResult]) -> pd.DataFrame:
+    """One row per round: placed, removed, attempts, how it ended (without the attempts themselves)."""
+    rows = []
+    for r in rounds:
+        d = r.to_dict()
+        d.pop("attempts")
+        d.update(
+            n_placed=r.n_placed, n_removed=r.n_removed, n_attempts=sum(a["executed"] for a in r.attempts)
+        )
+        for key in ("drawn", "placed", "removed"):
+            d[key] = " ".join(d[key])
+        rows.append(d)
+    return pd.DataFrame(rows)
+
+
+def attempts_frame(rounds: Iterable[RoundResult]) -> pd.DataFrame:
+    """One row per attempt (and per round that found no grasp, ``executed`` False), with the round's
+    dataset, mode and planner."""
+    rows = []
+    for r in rounds:
+        for a in r.attempts:
+            row = {"dataset": r.dataset, "mode": r.mode, "planner": r.planner, **a}
+            for key in ("touched_neighbours", "moved_neighbours"):
+                row[key] = " ".join(row[key])
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def read_rounds(run_dir: Path | str) -> list[RoundResult]:
+    """The rounds of a run directory, from its round logs (``trials/<mode>/NNN.mcap``), else from its
+    ``rounds.csv`` / ``attempts.csv`` (a ``record=false`` run). A damaged log is skipped."""
+    out = []
+    for path in iter_trial_logs(run_dir):
+        try:
+            out.append(RoundResult.from_dict(read_round(path)))
+        except (CorruptLogError, ValueError):
+            continue
+    if out or not (Path(run_dir) / ROUNDS_CSV).is_file():
+        return out
+    return _rounds_from_csv(Path(run_dir))
+
+
+def find_rounds(root: Path | str) -> list[RoundResult]:
+    """Every round below ``root`` (a run or a sweep directory): the run directories that hold a ``rounds.csv``
+    or round logs (``trials/pile/``, ``trials/packed/``), each read by :func:`read_rounds`."""
+    root = Path(root)
+    runs = {p.parent for p in root.rglob(ROUNDS_CSV)}
+    runs |= {d.parent for mode in CLUTTER_MODES for d in root.rglob(f"{TRIALS_DIR}/{mode}") if d.is_dir()}
+    return [r for run in sorted(runs) for r in read_rounds(run)]
+
+
+def _rounds_from_csv(run_dir: Path) -> list[RoundResult]:
+    rounds = pd.read_csv(run_dir / ROUNDS_CSV, keep_default_na=False)
+    attempts = (
+        pd.read_csv(run_dir / ATTEMPTS_CSV, keep_default_na=False)
+        if (run_dir / ATTEMPTS_CSV).is_file()
+        else None
+    )
+    out = []
+    for _, row in rounds.iterrows():
+        mine = [] if attempts is None else attempts[attempts["round"] == row["round"]].to_dict("records")
+        for a in mine:
+            for key in ("dataset", "mode", "planner"):
+                a.pop(key, None)
+            a["reason"] = a["reason"] or None
+            for key in ("touched_neighbours", "moved_neighbours"):
+                a[key] = str(a[key]).split()
+        out.append(
+            RoundResult(
+                dataset=row["dataset"], mode=row["mode"], planner=row["planner"], round=int(row["round"]),
+                seed=int(row["seed"]), drawn=str(row["drawn"]).split(), placed=str(row["placed"]).split(),
+                removed=str(row["removed"]).split(), end=row["end"], attempts=mine, error=str(row["error"]),
+            )
+        )  # fmt: skip
+    return out
+
+
+def clutter_table(rounds: list[RoundResult]) -> pd.DataFrame:
+    """Per (planner, mode, dataset): rounds, GSR and DR in % with their Wilson 95 % bounds, attempts per
+    round, how the rounds ended, planning latency per scene p50/p95 (ms, CPU and wall), and the count of
+    each failure reason of the failed attempts (``no_feasible_grasp``: rounds whose planner found none)."""
+    att, rnd = attempts_frame(rounds), rounds_frame(rounds)
+    rows = []
+    for (planner, mode, dataset), rg in rnd.groupby(["planner", "mode", "dataset"], sort=True):
+        ag = (
+            att[(att["planner"] == planner) & (att["mode"] == mode) & (att["dataset"] == dataset)]
+            if len(att)
+            else att
+        )
+        done = rg[rg["end"] != RoundEnd.ERROR.value]
+        executed = ag[ag["executed"]] if len(ag) else ag
+        n_ok = int(executed["success"].sum()) if len(executed) else 0
+        gsr = success_pct(n_ok, len(executed))
+        dr = success_pct(int(done["n_removed"].sum()), int(done["n_placed"].sum()))
+        cpu = percentiles(1e3 * ag["plan_cpu_s"]) if len(ag) else (float("nan"),) * 2
+        wall = percentiles(1e3 * ag["plan_s"]) if len(ag) else (float("nan"),) * 2
+        row = {
+            "planner": planner, "mode": mode, "dataset": dataset, "rounds": len(done),
+            "GSR_%": gsr[0], "GSR_lo": gsr[1], "GSR_hi": gsr[2],
+            "DR_%": dr[0], "DR_lo": dr[1], "DR_hi": dr[2],
+            "attempts": len(executed), "attempts/round": len(executed) / len(done) if len(done) else float("nan"),
+            "placed": int(done["n_placed"].sum()), "removed": int(done["n_removed"].sum()),
+            "plan_cpu_p50_ms": cpu[0], "plan_cpu_p95_ms": cpu[1], "plan_p50_ms": wall[0], "plan_p95_ms": wall[1],
+        }  # fmt: skip
+        for end in RoundEnd:
+            row[f"end_{end.value}"] = int((rg["end"] == end.value).sum())
+        if len(ag):
+            for reason, n in ag[~ag["success"]]["reason"].value_counts().sort_index().items():
+                row[f"fail_{reason}"] = int(n)
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def clutter_markdown(rounds: list[RoundResult]) -> str:
+    """The clutter table as markdown: one line per planner and scene, intervals in brackets."""
+    table = clutter_table(rounds)
+    if table.empty:
+        return "no clutter round finished"
+    lines = [
+        "| planner | scene | dataset | rounds | GSR % [95 % CI] | DR % [95 % CI] | attempts/round | plan CPU p50 / p95 ms "
+        "| plan wall p50 / p95 ms | round ends | failed attempts |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for _, r in table.iterrows():
+        ends = ", ".join(f"{c[4:]} {int(r[c])}" for c in table.columns if c.startswith("end_") and r[c] > 0)
+        fails = ", ".join(
+            f"{c[5:]} {int(r[c])}"
+            for c in table.columns
+            if c.startswith("fail_") and r[c] == r[c] and r[c] > 0
+        )
+        lines.append(
+            f"| {r['planner']} | {r['mode']} | {r['dataset']} | {r['rounds']} "
+            f"| {r['GSR_%']:.1f} [{r['GSR_lo']:.1f}, {r['GSR_hi']:.1f}] ({r['attempts']} attempts) "
+            f"| {r['DR_%']:.1f} [{r['DR_lo']:.1f}, {r['DR_hi']:.1f}] ({r['removed']}/{r['placed']}) "
+            f"| {r['attempts/round']:.2f} | {r['plan_cpu_p50_ms']:.1f} / {r['plan_cpu_p95_ms']:.1f} "
+            f"| {r['plan_p50_ms']:.1f} / {r['plan_p95_ms']:.1f} | {ends} | {fails or '-'} |"
+        )
+    return "\n".join(lines)

@@ -1,0 +1,181 @@
+"""The rounds of a clutter-removal job (``mode=pile``/``packed``): each drawn from the pool, run (or read
+back when its log is finished) and logged into one MCAP file per round; ``rounds.csv``, ``attempts.csv`` and
+``summary.md`` (GSR and DR with their intervals) beside them."""
+
+import logging
+import time
+import traceback
+from pathlib import Path
+
+import numpy as np
+from omegaconf import DictConfig
+from tqdm import tqdm
+
+from graspexp.core.clutter import RoundEnd, RoundResult
+from graspexp.core.files import write_atomic
+from graspexp.core.run_layout import (
+    LinkedRunPathError,
+    check_not_linked,
+    real_folder,
+    summary_md,
+    trial_log_path,
+)
+from graspexp.core.seeding import rng_for, round_seed
+from graspexp.planning import plan
+from graspexp.quality import fc_min_mu
+from graspexp.record import CorruptLogError, read_round, trial_recorder
+from graspexp.record.scene import round_bodies, round_scene
+from graspexp.record.writer import is_write_error
+from graspexp.report.clutter import (
+    ATTEMPTS_CSV,
+    ROUNDS_CSV,
+    attempts_frame,
+    clutter_markdown,
+    read_rounds,
+    rounds_frame,
+)
+from graspexp.run.locks import RunError
+from graspexp.run.objects import LoadedObject
+from graspexp.run.provenance import job_metadata
+from graspexp.run.resume import quarantine
+from graspexp.sim.clutter import RoundContext, RoundObject, run_round
+from graspexp.sim.trial import plain_config
+
+log = logging.getLogger(__name__)
+
+
+def draw_objects(pool: list[str], n: int, seed: int) -> list[str]:
+    """The ``n`` objects of the round of ``seed`` from ``pool``: without replacement when the pool holds
+    ``n``, else with (VGN draws with replacement from its object set)."""
+    idx = rng_for(seed, "draw").choice(len(pool), size=n, replace=len(pool) < n)
+    return [pool[int(i)] for i in idx]
+
+
+def run_rounds(
+    cfg: DictConfig, run_dir: Path, objects: list[str], models: dict[str, LoadedObject], bar: tqdm | None
+) -> list[RoundResult]:
+    """Every round of the job (``trials`` of them); finished rounds found in ``run_dir`` are read back. The pool
+    is ``objects`` less the unusable ones; an exception inside a round is that round's ``error`` end."""
+    plain = plain_config(cfg)
+    job_meta = job_metadata(cfg)
+    pool = [name for name in objects if name in models]
+    if not pool:
+        raise RunError(f"no object of the pool {objects} can be used (summary.md says why): nothing to place")
+    results = []
+    for r in range(cfg.trials):
+        seed = round_seed(plain, r)
+        drawn = draw_objects(pool, int(cfg.mode.objects_per_round), seed)
+        path = trial_log_path(run_dir, cfg.mode.name, r)
+        try:
+            real_folder(run_dir, path.parent)
+        except LinkedRunPathError as exc:
+            raise RunError(str(exc)) from None
+        result = finished_round(path, run_dir, r)
+        if result is None:
+            result = _run_one(cfg, plain, job_meta, path, r, seed, [models[n] for n in drawn])
+        results.append(result)
+        if bar is not None:
+            bar.set_postfix_str(f"round {r}: {result.end}, {result.n_removed}/{result.n_placed}")
+            bar.update()
+    return results
+
+
+def _run_one(cfg, plain, job_meta, path: Path, r: int, seed: int, loaded: list[LoadedObject]) -> RoundResult:
+    meta = {**job_meta, "object": cfg.mode.name, "trial": str(r), "trial_seed": str(seed),
+            "round_objects": " ".join(o.model.name for o in loaded)}  # fmt: skip
+    bodies = round_bodies(len(loaded))
+    try:
+        with trial_recorder(path if cfg.record else None, meta, plain, bodies) as rec:
+            scene = round_scene(plain, [o.hulls for o in loaded]) if cfg.record else None
+            ctx = RoundContext(
+                plain,
+                [RoundObject(o.model, o.hulls) for o in loaded],
+                r,
+                seed,
+                rec,
+                scene,
+                plan=plan,
+                quality=fc_min_mu,
+            )
+            try:
+                result = run_round(ctx)
+            except Exception as exc:  # one round's error is recorded; the job goes on
+                if is_write_error(exc):
+                    raise
+                log.error("round %d failed with an error: %s", r, exc)
+                result = error_round(cfg, r, seed, [o.model.name for o in loaded], exc)
+            rec.round_result(result.sim_time_s, result.to_dict())
+    except Exception as exc:
+        if not is_write_error(exc):
+            raise
+        raise RunError(f"cannot write the round log {path}: {exc}") from None
+    return result
+
+
+def error_round(cfg: DictConfig, r: int, seed: int, drawn: list[str], exc: BaseException) -> RoundResult:
+    """The ``error`` result of a round that raised ``exc`` (its one-line description recorded)."""
+    return RoundResult(
+        dataset=cfg.dataset.name, mode=cfg.mode.name, planner=cfg.planner.name, round=r, seed=seed, drawn=drawn,
+        placed=[], removed=[], end=RoundEnd.ERROR.value,
+        error="".join(traceback.format_exception_only(type(exc), exc)).strip(),
+    )  # fmt: skip
+
+
+def finished_round(path: Path, run_dir: Path, r: int) -> RoundResult | None:
+    """The result of round ``r``'s complete log at ``path``; None if absent. A log whose /round is unreadable or
+    of another round, and a round that ended in ``error``, are moved aside and the round is redone."""
+    if not path.exists():
+        return None
+    try:
+        result = RoundResult.from_dict(read_round(path))
+        if result.round != r:
+            raise ValueError(f"its result is of round {result.round}")
+    except (CorruptLogError, ValueError) as exc:
+        quarantine(path, run_dir, f"re-running round: {exc}")
+        return None
+    if result.end == RoundEnd.ERROR.value:
+        quarantine(path, run_dir, f"re-running round: it ended in an error ({result.error})")
+        return None
+    return result
+
+
+def write_round_summary(run_dir: Path, results: list[RoundResult]) -> str:
+    """Write ``rounds.csv``, ``attempts.csv`` and ``summary.md`` for ``results`` and every other finished round
+    log in ``run_dir``; the summary's text."""
+    done = {r.round for r in results}
+    every = sorted(
+        [*results, *(r for r in read_rounds(run_dir) if r.round not in done)], key=lambda r: r.round
+    )
+    text = clutter_markdown(every)
+    files = (
+        (Path(run_dir) / ROUNDS_CSV, rounds_frame(every).to_csv(index=False).encode()),
+        (Path(run_dir) / ATTEMPTS_CSV, attempts_frame(every).to_csv(index=False).encode()),
+        (summary_md(run_dir), (text + "\n").encode()),
+    )
+    for path, data in files:
+        try:
+            write_atomic(check_not_linked(path), lambda fh, data=data: fh.write(data))
+        except OSError as exc:
+            raise RunError(f"cannot write {path}: {exc.strerror or exc}") from None
+    return text
+
+
+def round_objective(results: list[RoundResult]) -> float:
+    """A clutter job's objective: its GSR as a fraction (successful / executed attempts over the rounds)."""
+    executed = [a["success"] for r in results for a in r.attempts if a["executed"]]
+    if not executed:
+        raise RunError("no grasp was attempted in any round: no success rate to return")
+    return float(np.mean(executed))
+
+
+def timed_rounds(cfg: DictConfig, run_dir: Path, objects, models, wall0: float, cpu0: float) -> float:
+    """Run the rounds, write the tables, print the summary; the job's objective."""
+    with tqdm(total=cfg.trials, desc=f"{cfg.mode.name}/{cfg.dataset.name}", disable=not cfg.progress) as bar:
+        results = run_rounds(cfg, run_dir, objects, models, bar)
+    text = write_round_summary(run_dir, results)
+    print(
+        f"\n{cfg.mode.name} / {cfg.dataset.name} / planner {cfg.planner.name}: {run_dir} ({len(results)} rounds, "
+        f"{time.perf_counter() - wall0:.1f} s wall, {time.process_time() - cpu0:.1f} s CPU)"
+    )
+    print(text)
+    return round_objective(results)

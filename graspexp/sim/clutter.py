@@ -1,0 +1,362 @@
+"""A clutter-removal round (``mode=pile``/``packed``): place, settle, then grasp one object at a time.
+
+The protocol of VGN (Breyer et al., CoRL 2020; ethz-asl/vgn ``experiments/clutter_removal.py``) and GIGA
+(Jiang et al., RSS 2021): each round ``mode.objects_per_round`` objects are dropped into a box that is
+lifted away (pile) or stood upright side by side (packed); once they rest, objects outside the workspace
+are taken away and the rest count as placed. Each attempt plans (every object's model at its perceived
+pose; the planner sees the others as obstacles; ``mode.pick_order`` chooses the target), executes the grasp
+exactly as a ``bin`` trial does (:func:`graspexp.sim.trial._execute`: approach, close, pull back, lift,
+hold; gripper-table contact fails it; touching a neighbour is allowed and recorded) and scores it. A held
+object is taken away; the others stay where the attempt left them and settle. The round ends when no
+object is left, the planner finds no grasp, or ``mode.max_consecutive_failures`` attempts in a row fail.
+"""
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from graspexp.config import JobConfig
+from graspexp.core.bodies import clutter_body
+from graspexp.core.clutter import AttemptResult, RoundEnd, RoundResult
+from graspexp.core.geometry import transform_points
+from graspexp.core.outcome import FailureReason, TrialResult
+from graspexp.core.seeding import derive_seed, rng_for
+from graspexp.datasets.model import ObjectModel
+from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
+from graspexp.planning.request import Neighbour, PlanRequest
+from graspexp.sim.clutter_scene import (
+    ClutterScene,
+    add_clutter_object,
+    clutter_scene,
+    packed_poses,
+    pile_drop_pose,
+)
+from graspexp.sim.contacts import gripper_touches
+from graspexp.sim.perceive import perceived_pose
+from graspexp.sim.shape import CollisionShape
+from graspexp.sim.trial import (
+    LogSink,
+    NullRecorder,
+    PlanFn,
+    QualityFn,
+    TrialContext,
+    TrialFailed,
+    _execute,
+    _grasp_record,
+    _Sim,
+)
+
+MOVED_M = 0.01
+"""A neighbour whose origin ended farther than this from where it was before an attempt was moved by it, m."""
+PLANNING_MODE = "bin"
+"""What a planner is told the mode is (:attr:`PlanRequest.mode`): the table under a clutter round is the
+bin's, so the paper's Eq. (2)-(3) score the paths."""
+
+
+@dataclass(frozen=True)
+class RoundObject:
+    """One drawn object of a round: its model and collision shape."""
+
+    model: ObjectModel
+    shape: CollisionShape
+
+
+@dataclass
+class RoundContext:
+    """Inputs of one round. ``round_seed`` derives every random draw of the round."""
+
+    cfg: JobConfig
+    objects: list[RoundObject]
+    """The drawn objects, by slot (body ``object_<slot>``)."""
+    round: int
+    round_seed: int
+    recorder: LogSink = field(default_factory=NullRecorder)
+    scene: object | None = None
+    """The round's Foxglove scene (:func:`graspexp.record.scene.round_scene`); None: no /scene messages."""
+    plan: PlanFn = field(kw_only=True)
+    quality: QualityFn = field(kw_only=True)
+
+
+class _RoundSim(_Sim):
+    """:class:`_Sim` over several objects: logs every object's pose, checks the target's speed, and at every
+    log tick (whether or not recorded) notes which neighbours the gripper touches."""
+
+    def __init__(self, ts: ClutterScene, cfg: JobConfig, recorder: LogSink, timings: dict[str, float]):
+        super().__init__(ts, cfg, recorder, timings)
+        self.touched: set[str] = set()
+
+    def track(self, name: str) -> None:
+        """Make body ``name`` the target: the speed check and the finger forces follow it."""
+        self.ts.target(name)
+        body = self.ts.object_body
+        self._velocities = (body.get_linear_velocity, body.get_angular_velocity)
+        self._last_velocities = None
+
+    def frames(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        out = {}
+        for name, (entity, _) in self.ts.bodies.items():
+            p = entity.pose
+            out[name] = (p.p, p.q)
+        if self.gripper is not None:
+            for link in (self.gripper.palm, *self.gripper.fingers):
+                lp = link.entity_pose
+                out[link.name] = (lp.p, lp.q)
+        return out
+
+    def steps_n(self, n: int, moves: list | None = None) -> None:
+        done = 0
+        while done < n:
+            k = min(self.log_every, n - done)
+            super().steps_n(k, None if moves is None else moves[done : done + k])
+            done += k
+            if self.gripper is not None:
+                self.touched |= gripper_touches(self._contacts(), self.ts.object_entity.name)
+
+    def release_gripper(self) -> None:
+        """Take the gripper out of the scene after an attempt."""
+        if self.gripper is not None:
+            for link in self.gripper.articulation.links:
+                self.ts.scene.remove_entity(link.entity)
+        self.gripper, self._links, self.touch = None, None, None
+
+
+def run_round(ctx: RoundContext) -> RoundResult:
+    """Run one round; never raises for a physical failure (each attempt's reason is in its row)."""
+    cfg = ctx.cfg
+    wall0, cpu0 = time.perf_counter(), time.process_time()
+    res = RoundResult(
+        dataset=cfg.dataset.name,
+        mode=cfg.mode.name,
+        planner=cfg.planner.name,
+        round=ctx.round,
+        seed=ctx.round_seed,
+        drawn=[o.model.name for o in ctx.objects],
+        placed=[],
+        removed=[],
+        end=RoundEnd.ERROR.value,
+    )
+    timings = dict.fromkeys(("build", "settle", "plan", "quality", "execute", "log", "physics"), 0.0)
+    ts = clutter_scene(cfg.mode, cfg)
+    sim = _RoundSim(ts, cfg, ctx.recorder, timings)
+    if ctx.scene is not None:
+        ctx.recorder.scene(0.0, ctx.scene.static)
+    try:
+        _place(ctx, sim)
+        res.placed = sorted(ts.bodies)
+        sim.phase("settled", {"placed": res.placed})
+        res.end = _attempts(ctx, sim, res).value
+    except TrialFailed as e:  # the scene itself went unstable while settling
+        res.error = str(e)
+        sim.phase("failed", {"reason": e.reason.value, "detail": str(e)})
+    res.wall_s, res.cpu_s = time.perf_counter() - wall0, time.process_time() - cpu0
+    res.sim_time_s = sim.t
+    sim.phase("round_end", {"end": res.end, "removed": res.removed})
+    return res
+
+
+def _place(ctx: RoundContext, sim: _RoundSim) -> None:
+    """Drop (pile) or stand (packed) the drawn objects, settle, lift the tray away, settle, and take away
+    every object outside the workspace or off the table."""
+    cfg, ts = ctx.cfg, sim.ts
+    mode = cfg.mode
+    rng = rng_for(ctx.round_seed, "place")
+    sim.phase("drop", {"objects": [o.model.name for o in ctx.objects]})
+    if mode.name == "pile":
+        for slot, obj in enumerate(ctx.objects):
+            top = max((ts.bodies[b][1].compute_global_aabb_tight()[1][2] for b in ts.bodies), default=0.0)
+            pose = pile_drop_pose(obj.model, mode, float(top), rng)
+            add_clutter_object(ts, clutter_body(slot), obj.model, obj.shape, pose, cfg)
+            _settle_all(sim)
+        sim.phase("remove_tray")
+        ts.remove_tray()
+    else:
+        poses = packed_poses([o.model for o in ctx.objects], mode, float(cfg.rot.drop_height_m), rng)
+        for slot, (obj, pose) in enumerate(zip(ctx.objects, poses, strict=True)):
+            if pose is not None:
+                add_clutter_object(ts, clutter_body(slot), obj.model, obj.shape, pose, cfg)
+    _settle_all(sim)
+    _take_away_outside(ctx, sim)
+
+
+def _settle_all(sim: _RoundSim) -> bool:
+    """Step until every object rests (both settle speeds for ``sim.settle_hold_s``, after
+    ``sim.settle_min_s``) or ``sim.settle_max_s`` runs out; whether they came to rest."""
+    cfg = sim.cfg.sim
+    bodies = [b for _, b in sim.ts.bodies.values()]
+    if not bodies:
+        return True
+    sim.track(next(iter(sim.ts.bodies)))
+    linear_sq, angular_sq = cfg.settle_linear_mps**2, cfg.settle_angular_radps**2
+    min_steps, hold = int(cfg.settle_min_s / sim.dt), max(1, round(cfg.settle_hold_s / sim.dt))
+    still = 0
+    with sim.timed("settle"):
+        for i in range(int(cfg.settle_max_s / sim.dt)):
+            sim.step()
+            rest = True
+            for body in bodies:
+                v, w = body.get_linear_velocity(), body.get_angular_velocity()
+                if v.dot(v) >= linear_sq or w.dot(w) >= angular_sq:
+                    rest = False
+                    break
+            still = still + 1 if rest else 0
+            if i + 1 >= min_steps and still >= hold:
+                return True
+    sim.phase("settle_timeout", {"cap_s": cfg.settle_max_s})
+    return False
+
+
+def _take_away_outside(ctx: RoundContext, sim: _RoundSim) -> list[str]:
+    """Remove the objects whose centre of mass is outside the workspace or that fell off the table (VGN's
+    ``remove_objects_outside_roi``); their names."""
+    ts, mode = sim.ts, ctx.cfg.mode
+    wx, wy = mode.workspace_half_size_m
+    below = ts.table_z - ctx.cfg.sim.fell_below_m
+    gone = []
+    for name, (entity, body) in list(ts.bodies.items()):
+        com = (entity.pose * body.cmass_local_pose).p
+        if abs(com[0]) > wx or abs(com[1]) > wy or com[2] < below:
+            gone.append(name)
+            _remove(ctx, sim, name)
+    if gone:
+        sim.phase("taken_away", {"bodies": gone})
+    return gone
+
+
+def _remove(ctx: RoundContext, sim: _RoundSim, name: str) -> None:
+    sim.ts.remove_body(name)
+    if ctx.scene is not None:
+        ctx.recorder.delete_entities(sim.log_t, ctx.scene.bodies[name])
+
+
+def _attempts(ctx: RoundContext, sim: _RoundSim, res: RoundResult) -> RoundEnd:
+    """Grasp until the table is clear, no grasp is found, or the failure limit; each attempt's row into
+    ``res.attempts``."""
+    cfg, ts = ctx.cfg, sim.ts
+    failures = 0
+    attempt = 0
+    while ts.bodies:
+        seed = derive_seed(ctx.round_seed, "attempt", attempt)
+        row, grasp = _plan_scene(ctx, sim, attempt, seed)
+        if grasp is None:
+            res.attempts.append(row.to_dict())
+            return RoundEnd.NO_GRASP
+        name = clutter_body(row.slot)
+        before = {b: ts.pose_of(b)[:3, 3] for b in ts.bodies if b != name}
+        sim.track(name)
+        sim.touched, sim.touched_support = set(), False
+        t0 = time.perf_counter()
+        trial_res = TrialResult(cfg.dataset.name, row.target, cfg.mode.name, cfg.rot.name, cfg.planner.name,
+                                ctx.round, seed, False, None)  # fmt: skip
+        obj = ctx.objects[row.slot]
+        tctx = TrialContext(
+            cfg,
+            obj.model,
+            obj.shape,
+            ctx.round,
+            seed,
+            ctx.recorder,
+            ctx.scene,
+            plan=ctx.plan,
+            quality=ctx.quality,
+        )
+        try:
+            with sim.timed("execute"):
+                _execute(tctx, sim, grasp, trial_res)
+            row.success = True
+        except TrialFailed as e:
+            row.reason = e.reason.value
+            sim.phase("failed", {"reason": e.reason.value, "detail": str(e), "target": name})
+        row.slip_m, row.touched_support = trial_res.slip_m, sim.touched_support
+        row.touched_neighbours = sorted(sim.touched - {name})
+        sim.release_gripper()
+        if row.success:
+            _remove(ctx, sim, name)
+            res.removed.append(name)
+        sim.phase(
+            "attempt_end", {"attempt": attempt, "target": name, "success": row.success, "reason": row.reason}
+        )
+        _settle_all(sim)
+        _take_away_outside(ctx, sim)
+        row.moved_neighbours = sorted(
+            b
+            for b, p in before.items()
+            if b in ts.bodies and np.linalg.norm(ts.pose_of(b)[:3, 3] - p) > MOVED_M
+        )
+        row.execute_s, row.sim_time_s = time.perf_counter() - t0, sim.t
+        res.attempts.append(row.to_dict())
+        failures = 0 if row.success else failures + 1
+        attempt += 1
+        if failures >= cfg.mode.max_consecutive_failures:
+            return RoundEnd.FAILURE_LIMIT
+    return RoundEnd.CLEARED
+
+
+def _plan_scene(
+    ctx: RoundContext, sim: _RoundSim, attempt: int, seed: int
+) -> tuple[AttemptResult, Grasp | None]:
+    """Plan the next grasp of the scene (``mode.pick_order``); the attempt's row and the grasp (None: none
+    found on any object). Every object is seen at its perceived pose (``perception.noise``)."""
+    cfg, ts = ctx.cfg, sim.ts
+    noise = cfg.perception.noise
+    seen = {}
+    for name in ts.bodies:
+        slot = int(name.rsplit("_", 1)[1])
+        true = ts.pose_of(name)
+        pose = perceived_pose(true, noise.trans_mm, noise.rot_deg, rng_for(seed, "noise", slot))
+        seen[name] = (slot, pose, transform_points(pose, ctx.objects[slot].model.points))
+    order = sorted(seen)
+    if cfg.mode.pick_order == "top_most":
+        order.sort(key=lambda b: -float(seen[b][2][:, 2].max()))
+    plans: list[tuple[float, int, str, Grasp]] = []
+    wall, cpu, n = 0.0, 0.0, 0
+    with sim.timed("plan"):
+        for rank, name in enumerate(order):
+            slot, pose, points = seen[name]
+            model = ctx.objects[slot].model
+            req = PlanRequest(
+                points=points,
+                normals=model.normals @ pose[:3, :3].T,
+                area_mask=model.area_mask,
+                object_pose=pose,
+                table_z=ts.table_z,
+                mode=PLANNING_MODE,
+                gripper=cfg.gripper,
+                planner=cfg.planner,
+                cost=cfg.cost,
+                seed=derive_seed(seed, "plan", slot),
+                support_blocks_gripper=bool(cfg.mode.support_collides_with_gripper),
+                neighbours=tuple(
+                    Neighbour(s, ctx.objects[s].model.name, p, q)
+                    for b, (s, q, p) in seen.items()
+                    if b != name
+                ),
+            )
+            t0, c0 = time.perf_counter(), time.thread_time()
+            try:
+                grasp = ctx.plan(req).grasp
+            except NoFeasibleGrasp:
+                grasp = None
+            wall, cpu, n = wall + time.perf_counter() - t0, cpu + time.thread_time() - c0, n + 1
+            if grasp is not None:
+                cost = grasp.cost if np.isfinite(grasp.cost) else np.inf
+                plans.append((bool(grasp.extras.get("touches_neighbours", False)), cost, rank, name, grasp))
+                if cfg.mode.pick_order == "top_most":
+                    break
+    first = seen[order[0]][0]
+    row = AttemptResult(
+        round=ctx.round, attempt=attempt, target=ctx.objects[first].model.name, slot=first, executed=False,
+        success=False, reason=FailureReason.NO_FEASIBLE_GRASP.value, pick_order=cfg.mode.pick_order,
+        n_left=len(seen), n_planned=n, plan_s=wall, plan_cpu_s=cpu, sim_time_s=sim.t,
+    )  # fmt: skip
+    if not plans:
+        sim.phase("plan", {"attempt": attempt, "found": False, "n_planned": n})
+        return row, None
+    *_, name, grasp = min(plans, key=lambda p: p[:3])  # a grasp clear of the neighbours first, then cost
+    slot = seen[name][0]
+    row.target, row.slot, row.executed, row.reason = ctx.objects[slot].model.name, slot, True, None
+    row.grasp_cost, row.grasp_width_m, row.n_feasible = grasp.cost, grasp.width_m, grasp.n_feasible
+    sim.phase("plan", {"attempt": attempt, "target": name, "object": row.target, "n_planned": n,
+                       "pick_order": cfg.mode.pick_order, "plan_s": wall})  # fmt: skip
+    ctx.recorder.grasp(sim.log_t, {**_grasp_record(grasp), "target": name})
+    return row, grasp

@@ -1,0 +1,47 @@
+"""The clutter table (``report`` on a ``mode=pile``/``packed`` run): GSR over executed attempts, DR over the
+objects placed, both with Wilson intervals, the rounds' ends, the failure reasons and the planning latency."""
+
+import pytest
+
+from graspexp.core.clutter import AttemptResult, RoundResult
+from graspexp.report.clutter import attempts_frame, clutter_markdown, clutter_table, rounds_frame
+from graspexp.report.stats import wilson_interval
+
+
+def _attempt(r, i, success, reason=None, executed=True, plan_cpu_s=0.004):
+    return AttemptResult(
+        round=r, attempt=i, target="can", slot=i, executed=executed, success=success, reason=reason,
+        pick_order="lowest_cost", n_left=3 - i, n_planned=3 - i, plan_s=2 * plan_cpu_s, plan_cpu_s=plan_cpu_s,
+    ).to_dict()  # fmt: skip
+
+
+def _rounds():
+    cleared = RoundResult(
+        "ycb", "pile", "optimal", 0, 1, ["a", "b", "c"], ["object_0", "object_1", "object_2"],
+        ["object_0", "object_1", "object_2"], "cleared",
+        [_attempt(0, 0, True), _attempt(0, 1, False, "dropped"), _attempt(0, 2, True), _attempt(0, 3, True)],
+    )  # fmt: skip
+    stuck = RoundResult(
+        "ycb", "pile", "optimal", 1, 2, ["a", "b", "c"], ["object_0", "object_1"], ["object_0"], "no_grasp",
+        [_attempt(1, 0, True), _attempt(1, 1, False, "no_feasible_grasp", executed=False)],
+    )  # fmt: skip
+    return [cleared, stuck]
+
+
+def test_gsr_counts_executed_attempts_and_dr_the_objects_placed():
+    (row,) = clutter_table(_rounds()).to_dict("records")
+    assert row["attempts"] == 5 and row["GSR_%"] == pytest.approx(80.0)
+    assert (row["removed"], row["placed"]) == (4, 5) and row["DR_%"] == pytest.approx(80.0)
+    lo, hi = wilson_interval(4, 5)
+    assert (row["DR_lo"], row["DR_hi"]) == pytest.approx((100 * lo, 100 * hi))
+    assert row["attempts/round"] == pytest.approx(2.5)
+    assert (row["end_cleared"], row["end_no_grasp"], row["end_failure_limit"]) == (1, 1, 0)
+    assert (row["fail_dropped"], row["fail_no_feasible_grasp"]) == (1, 1)
+    assert row["plan_cpu_p50_ms"] == pytest.approx(4.0)
+
+
+def test_the_tables_have_one_row_per_round_and_per_attempt():
+    rounds = _rounds()
+    assert len(rounds_frame(rounds)) == 2 and len(attempts_frame(rounds)) == 6
+    text = clutter_markdown(rounds)
+    assert "| optimal | pile | ycb | 2 | 80.0 [" in text and "dropped 1" in text
