@@ -60,6 +60,31 @@ not the time measurements (``timings_s``, ``registration_cpu_s``: they differ be
 added later (with no number moved) does not turn every page stale; a test checks that each name is a field."""
 
 
+ATTEMPT_KEYS: tuple[str, ...] = ("dataset", "mode", "planner", "round", "attempt")
+"""A grasp attempt of a clutter round (attempts.csv, ``mode=pile``/``packed``): the rows are sorted by these."""
+ATTEMPT_COLUMNS: tuple[str, ...] = (
+    "target",
+    "slot",
+    "executed",
+    "success",
+    "reason",
+    "pick_order",
+    "n_left",
+    "n_planned",
+    "grasp_cost",
+    "grasp_width_m",
+    "n_feasible",
+    "slip_m",
+    "touched_support",
+    "touched_neighbours",
+    "moved_neighbours",
+    "sim_time_s",
+)
+"""The attempts.csv columns a clutter page's fingerprint hashes
+(:class:`graspexp.core.clutter.AttemptResult`): every outcome, not the time measurements (``plan_s``,
+``plan_cpu_s``, ``execute_s``)."""
+
+
 class PageError(ValueError):
     """A page file without its generated block, or with a malformed one."""
 
@@ -76,13 +101,18 @@ class Stamp:
 def outcome_fingerprint(tables: Iterable[pd.DataFrame]) -> str:
     """SHA-256 (first 16 hex digits) of the trial outcomes in ``tables`` (results.csv frames read with
     ``dtype=str``): :data:`OUTCOME_COLUMNS` of every row, rows sorted by :data:`OUTCOME_KEYS`; a column a
-    table lacks counts as empty."""
-    frames = [t.reindex(columns=[*OUTCOME_KEYS, *OUTCOME_COLUMNS]) for t in tables]
-    if not frames:
+    table lacks counts as empty. Clutter runs' attempts.csv frames: :data:`ATTEMPT_COLUMNS` by
+    :data:`ATTEMPT_KEYS`."""
+    tables = list(tables)
+    if not tables:
         raise ValueError("a fingerprint needs at least one results table")
-    rows = pd.concat(frames, ignore_index=True)
+    kinds = {"attempt" in t.columns for t in tables}
+    if len(kinds) > 1:
+        raise ValueError("a fingerprint hashes trial tables or attempt tables, not both")
+    keys, columns = (ATTEMPT_KEYS, ATTEMPT_COLUMNS) if kinds.pop() else (OUTCOME_KEYS, OUTCOME_COLUMNS)
+    rows = pd.concat([t.reindex(columns=[*keys, *columns]) for t in tables], ignore_index=True)
     rows = rows.astype(object).where(rows.notna(), "").astype(str)
-    rows = rows.sort_values(list(OUTCOME_KEYS), kind="stable")
+    rows = rows.sort_values(list(keys), kind="stable")
     text = rows.to_csv(index=False, lineterminator="\n")
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 

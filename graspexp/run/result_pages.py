@@ -13,6 +13,7 @@ from collections.abc import Callable, Sequence
 
 from graspexp.report.build import agreement_section, build_report
 from graspexp.report.camera import COLUMNS, LEARNED_COLUMNS, camera_markdown
+from graspexp.report.clutter import clutter_markdown, find_rounds
 from graspexp.report.collect import collect
 from graspexp.report.gallery import write_gallery
 from graspexp.report.learned import learned_markdown
@@ -269,6 +270,36 @@ STUDY_XYZ = Sweep(
     settings=False,
 )
 
+CLUTTER_PLANNERS = ("optimal", "optimal_plus", "antipodal")
+"""The planners of the clutter page: the paper's, this project's and antipodal sampling."""
+CLUTTER = Sweep(
+    Reading(
+        "clutter",
+        (
+            "mode=pile,packed",
+            f"planner={','.join(CLUTTER_PLANNERS)}",
+            "dataset=ycb",
+            "trials=100",
+            "record=false",
+        ),
+        "clutter removal, pile and packed, 100 rounds of 5 objects from the staged YCB objects, exact poses",
+    ),
+    settings=False,
+)
+CLUTTER_FINGERPRINT = tuple(
+    Sweep(Reading(f"clutter_{p}", (f"planner={p}",), f"{p} in one clutter round"), settings=False)
+    for p in CLUTTER_PLANNERS
+)
+"""One round of each planner in each scene (:data:`CLUTTER_SETTINGS`): 5 objects drawn from the pool."""
+CLUTTER_SETTINGS = (("pile", "z"), ("packed", "z"))
+"""The fingerprint's scenes (the drop rotation is not read by the clutter modes)."""
+
+
+def _clutter(sweep: Sweep) -> Callable[[PageInput], str]:
+    """The clutter table (:func:`graspexp.report.clutter.clutter_markdown`) of ``sweep``'s rounds."""
+    return lambda page: clutter_markdown(find_rounds(page.runs[sweep])) + "\n"
+
+
 PAGES: tuple[Page, ...] = (
     Page("readme", "README.md", (DEFAULT,), _readme(DEFAULT), (DEFAULT,), admonition=False),
     Page(
@@ -327,6 +358,15 @@ PAGES: tuple[Page, ...] = (
         (VGN_PANDA, VGN_RG2),
         _learned({"vgn, gripper=panda": VGN_PANDA, "vgn, gripper=rg2 (transfer)": VGN_RG2}),
         (VGN_PANDA, VGN_RG2),
+    ),
+    Page(
+        "clutter",
+        "docs/results/clutter.md",
+        (CLUTTER,),
+        _clutter(CLUTTER),
+        CLUTTER_FINGERPRINT,
+        ("dataset=ycb", "trials=1"),
+        CLUTTER_SETTINGS,
     ),
     Page("tuning", "docs/results/tuning.md", (STUDY_Z,), _tuning(STUDY_Z), (DEFAULT,)),
     Page("tuning_xyz", "docs/results/xyz/tuning.md", (STUDY_XYZ,), _tuning(STUDY_XYZ), (DEFAULT,)),

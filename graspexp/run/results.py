@@ -41,6 +41,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from graspexp.core.run_layout import results_csv
+from graspexp.report.clutter import ATTEMPTS_CSV
 from graspexp.report.pages import (
     Provenance,
     duration,
@@ -100,9 +102,11 @@ class Page:
     sweeps: tuple[Sweep, ...]
     render: Callable[[PageInput], str]
     fingerprint: tuple[Sweep, ...]
-    """Sweeps whose outcomes this page's numbers depend on; each runs on :data:`FINGERPRINT_SETTINGS`
-    with ``fingerprint_subset``."""
+    """Sweeps whose outcomes this page's numbers depend on; each runs on ``fingerprint_settings`` with
+    ``fingerprint_subset``."""
     fingerprint_subset: tuple[str, ...] = FINGERPRINT_SUBSET
+    fingerprint_settings: tuple[tuple[str, str], ...] = FINGERPRINT_SETTINGS
+    """(mode, rot) of each fingerprint job."""
     admonition: bool = True
     """Whether the provenance is a Markdown admonition (the site) or plain paragraphs (the README)."""
 
@@ -143,7 +147,7 @@ def fingerprint_jobs(page: Page, overrides: Sequence[str] = ()) -> list[tuple[st
             (f"mode={mode}", f"rot={rot}", "record=false", "progress=false"),
         )
         for s in page.fingerprint
-        for mode, rot in FINGERPRINT_SETTINGS
+        for mode, rot in page.fingerprint_settings
     ]
 
 
@@ -186,7 +190,8 @@ class ResultsError(RuntimeError):
 
 
 def _run_fingerprint_job(overrides: tuple[str, ...], run_dir: str) -> str:
-    """Run one fingerprint job into ``run_dir`` (its printout swallowed); returns its results.csv path."""
+    """Run one fingerprint job into ``run_dir`` (its printout swallowed); returns the path of its table of
+    outcomes: results.csv, or attempts.csv for a clutter job."""
     from graspexp.config import ConfigError
     from graspexp.config.compose import compose_validated
     from graspexp.datasets import DatasetError
@@ -199,7 +204,8 @@ def _run_fingerprint_job(overrides: tuple[str, ...], run_dir: str) -> str:
             run_in_dir(cfg, Path(run_dir))
     except (ConfigError, DatasetError, RunError) as exc:
         raise ResultsError(f"the fingerprint job {shlex.join(overrides)} cannot run: {exc}") from None
-    return str(Path(run_dir) / "results.csv")
+    trials = results_csv(run_dir)
+    return str(trials if trials.is_file() else Path(run_dir) / ATTEMPTS_CSV)
 
 
 def run_fingerprints(

@@ -10,9 +10,12 @@ import pandas as pd
 import pytest
 
 from graspexp.config.compose import compose_validated
+from graspexp.core.clutter import AttemptResult
 from graspexp.core.outcome import TrialResult
 from graspexp.datasets import select_objects
 from graspexp.report.pages import (
+    ATTEMPT_COLUMNS,
+    ATTEMPT_KEYS,
     BEGIN,
     END,
     OUTCOME_COLUMNS,
@@ -252,3 +255,21 @@ def test_a_changed_page_is_not_a_code_change_but_a_changed_module_is(tmp_path: P
     assert not commit_of(tmp_path)[0].endswith("+changes")
     (tmp_path / "module.py").write_text("b\n")
     assert commit_of(tmp_path)[0].endswith("+changes")
+
+
+def test_a_clutter_fingerprint_hashes_attempt_outcomes_not_their_times():
+    def attempts(**changes: str) -> pd.DataFrame:
+        row = {k: "0" for k in (*ATTEMPT_KEYS, *ATTEMPT_COLUMNS)} | {"success": "True", "plan_s": "0.1"}
+        return pd.DataFrame([row | changes])
+
+    base = outcome_fingerprint([attempts()])
+    assert outcome_fingerprint([attempts(plan_s="0.2", plan_cpu_s="0.3", execute_s="1")]) == base
+    assert outcome_fingerprint([attempts(success="False")]) != base
+    assert outcome_fingerprint([attempts(moved_neighbours="object_1")]) != base
+    with pytest.raises(ValueError, match="not both"):
+        outcome_fingerprint([attempts(), _results()])
+    assert set(ATTEMPT_KEYS + ATTEMPT_COLUMNS) <= set(AttemptResult.__dataclass_fields__) | {
+        "dataset",
+        "mode",
+        "planner",
+    }
