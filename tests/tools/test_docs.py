@@ -126,7 +126,7 @@ FRESH_INSTALL = (
     "python3 -m venv .venv && . .venv/bin/activate && pip install -e '.[test]' && python -m graspexp"
 )
 """The README's first command (CI and other tools rely on it, word for word)."""
-FRESH_TESTS = ". .venv/bin/activate && GRASPEXP_DATA=../shared/datasets python -m pytest -q"
+FRESH_TESTS = ". .venv/bin/activate && GRASPEXP_DATA=../shared/datasets python -m pytest -q -n 2"
 """The README's second command."""
 RUN_FOR_REAL = (
     "python -m graspexp 'objects=[mug]'",
