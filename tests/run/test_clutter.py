@@ -115,7 +115,7 @@ def test_objects_are_drawn_per_round_from_the_pool():
 @pytest.mark.parametrize(
     "override, message",
     [
-        ("perception.source=depth", "perception.source=depth is not available with mode=pile yet"),
+        ("live=true", "live=true is not available with mode=pile yet"),
         ("mode.pick_order=random", "mode.pick_order='random' is invalid"),
     ],
 )
