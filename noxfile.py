@@ -25,7 +25,7 @@ CHECKPOINTS = os.environ.get("GRASPEXP_CHECKPOINTS", str((Path(DATA) / ".." / "p
 def tests(session: nox.Session) -> None:
     """The test suite (real SAPIEN physics) with the shared meshes as data root, in two processes."""
     session.install("-e", ".[test]")
-    session.run("pytest", "-n", "2", *session.posargs, env=ENV)
+    session.run("pytest", "-n", "2", "--dist", "worksteal", *session.posargs, env=ENV)
 
 
 def _install_learned(session: nox.Session) -> bool:
