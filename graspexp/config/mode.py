@@ -60,7 +60,9 @@ class ModeConfig:
     planner sees the others as obstacles) and execute the grasp of least cost (the paper's Eq. 2-3 choice
     extended over the objects: the same rule that picks a path picks the object); ``top_most``: plan the
     objects from the highest top down and execute the first grasp found (a heap is cleared from the top,
-    the order a person follows, and only one plan is paid per attempt when it succeeds)."""
+    the order a person follows, and only one plan is paid per attempt when it succeeds). Planners that plan on
+    the camera (``vgn``, ``antipodal_view``) follow the same rule: each object in turn is the observation's
+    ``target_id`` (vgn: the detections that hold it, cost 1 - quality)."""
 
 
 CLUTTER_MODES = ("pile", "packed")

@@ -143,25 +143,13 @@ def validate(cfg: DictConfig | Any) -> None:
 
 
 def _check_clutter(cfg: DictConfig) -> None:
-    """A clutter round (``mode=pile``/``packed``) plans on every object's model at its perceived pose; the
-    depth camera in clutter (each object registered from one shared view) is not built yet: one line."""
+    """A clutter round (``mode=pile``/``packed``) is not shown live yet: one line."""
     name = OmegaConf.select(cfg, "mode.name")
     if name not in mode.CLUTTER_MODES:
         return
-    planner = OmegaConf.select(cfg, "planner.name")
     if OmegaConf.select(cfg, "live") is True:
         raise ConfigError(
             f"live=true is not available with mode={name} yet: its log opens in Foxglove afterwards"
-        )
-    if OmegaConf.select(cfg, "perception.source") == "depth":
-        raise ConfigError(
-            f"perception.source=depth is not available with mode={name} yet: use perception.source=truth "
-            "(every object's model at its exact or noisy pose, perception.noise)"
-        )
-    if get_plugin(planner).plugin.needs_observation:
-        raise ConfigError(
-            f"planner={planner} plans on the camera's cloud, which mode={name} does not render yet: choose a "
-            "planner that plans on the object models (optimal, optimal_plus, antipodal, obb, random)"
         )
 
 

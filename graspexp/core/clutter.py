@@ -56,6 +56,15 @@ class AttemptResult:
     """Bodies (``object_<slot>``) other than the target that the gripper touched during the attempt (allowed)."""
     moved_neighbours: list[str] = field(default_factory=list)
     """Bodies other than the target that ended more than ``MOVED_M`` from where they were before it."""
+    pose_trans_err_mm: float = float("nan")
+    """``perception.source=depth``: distance between the target's registered and true origin before the
+    attempt, mm (NaN when no pose was registered; as :class:`graspexp.core.outcome.TrialResult`)."""
+    pose_rot_err_deg: float = float("nan")
+    """... angle between the target's registered and true orientation, degrees."""
+    pose_adds_mm: float = float("nan")
+    """... ADD-S of the target's registered pose against the true one, mm."""
+    registration_fitness: float = float("nan")
+    """... Open3D's ICP fitness of the target's registration, in [0, 1]."""
     execute_s: float = 0.0
     """Wall time of the attempt's execution (approach to hold) and the settling after it, s."""
     sim_time_s: float = 0.0

@@ -11,6 +11,7 @@ object is taken away; the others stay where the attempt left them and settle. Th
 object is left, the planner finds no grasp, or ``mode.max_consecutive_failures`` attempts in a row fail.
 """
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 
@@ -33,7 +34,7 @@ from graspexp.sim.clutter_scene import (
     pile_drop_pose,
 )
 from graspexp.sim.contacts import gripper_touches
-from graspexp.sim.perceive import perceived_pose
+from graspexp.sim.perceive import perceive_scene, slot_id
 from graspexp.sim.shape import CollisionShape
 from graspexp.sim.trial import (
     LogSink,
@@ -298,12 +299,13 @@ def _plan_scene(
     """Plan the next grasp of the scene (``mode.pick_order``); the attempt's row and the grasp (None: none
     found on any object). Every object is seen at its perceived pose (``perception.noise``)."""
     cfg, ts = ctx.cfg, sim.ts
-    noise = cfg.perception.noise
+    slots = {name: int(name.rsplit("_", 1)[1]) for name in ts.bodies}
+    view = perceive_scene(
+        cfg, {s: (ctx.objects[s].model, ts.pose_of(name)) for name, s in slots.items()}, ts.table_z, seed
+    )
     seen = {}
-    for name in ts.bodies:
-        slot = int(name.rsplit("_", 1)[1])
-        true = ts.pose_of(name)
-        pose = perceived_pose(true, noise.trans_mm, noise.rot_deg, rng_for(seed, "noise", slot))
+    for name, slot in slots.items():
+        pose = view.poses[slot]
         seen[name] = (slot, pose, transform_points(pose, ctx.objects[slot].model.points))
     order = sorted(seen)
     if cfg.mode.pick_order == "top_most":
@@ -331,6 +333,9 @@ def _plan_scene(
                     for b, (s, q, p) in seen.items()
                     if b != name
                 ),
+                observation=None
+                if view.observation is None
+                else dataclasses.replace(view.observation, target_id=slot_id(slot)),
             )
             t0, c0 = time.perf_counter(), time.thread_time()
             try:
@@ -349,6 +354,7 @@ def _plan_scene(
         success=False, reason=FailureReason.NO_FEASIBLE_GRASP.value, pick_order=cfg.mode.pick_order,
         n_left=len(seen), n_planned=n, plan_s=wall, plan_cpu_s=cpu, sim_time_s=sim.t,
     )  # fmt: skip
+    _pose_errors(row, view.errors.get(first))
     if not plans:
         sim.phase("plan", {"attempt": attempt, "found": False, "n_planned": n})
         return row, None
@@ -356,7 +362,15 @@ def _plan_scene(
     slot = seen[name][0]
     row.target, row.slot, row.executed, row.reason = ctx.objects[slot].model.name, slot, True, None
     row.grasp_cost, row.grasp_width_m, row.n_feasible = grasp.cost, grasp.width_m, grasp.n_feasible
+    _pose_errors(row, view.errors.get(slot))
     sim.phase("plan", {"attempt": attempt, "target": name, "object": row.target, "n_planned": n,
                        "pick_order": cfg.mode.pick_order, "plan_s": wall})  # fmt: skip
     ctx.recorder.grasp(sim.log_t, {**_grasp_record(grasp), "target": name})
     return row, grasp
+
+
+def _pose_errors(row: AttemptResult, errors: dict[str, float] | None) -> None:
+    """The target's registered-pose errors into its row (``perception.source=depth``; else left NaN)."""
+    if errors is not None:
+        row.pose_trans_err_mm, row.pose_rot_err_deg = errors["trans_mm"], errors["rot_deg"]
+        row.pose_adds_mm, row.registration_fitness = errors["adds_mm"], errors["fitness"]

@@ -7,6 +7,7 @@ camera unless the planner reads it). ``depth``: the camera renders the scene and
 from its cloud, from a prior (the noisy true pose) or globally (``perception.registration.prior=none``).
 """
 
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -65,12 +66,18 @@ def scene_bodies(
 ) -> tuple[list[MeshBody], list[BoxBody]]:
     """The camera's scene: the object's mesh at its true pose (id :data:`TARGET_ID`), the support box
     (top at ``table_z``, half sizes ``support_half_m``; None once removed) and the floor (top z = 0)."""
+    return [MeshBody(model.mesh, true_pose, TARGET_ID)], support_boxes(table_z, support_half_m)
+
+
+def support_boxes(table_z: float, support_half_m: tuple[float, float] | None) -> list[BoxBody]:
+    """The floor (top z = 0) and the support box (top at ``table_z``, half sizes ``support_half_m``, m; None:
+    no support) as the camera sees them (id 0)."""
     fx, fy, fz = FLOOR_HALF_SIZE_M
     boxes = [BoxBody(np.array([-fx, -fy, -2 * fz]), np.array([fx, fy, 0.0]))]
     if support_half_m is not None:
         hx, hy = support_half_m
         boxes.append(BoxBody(np.array([-hx, -hy, 0.0]), np.array([hx, hy, table_z])))
-    return [MeshBody(model.mesh, true_pose, TARGET_ID)], boxes
+    return boxes
 
 
 def perceive(
@@ -94,3 +101,66 @@ def perceive(
     )
     errors = pose_errors(reg.pose, true_pose, model.points)
     return Perceived(pose=reg.pose, prior=prior, observation=obs, registration=reg, errors=errors)
+
+
+def slot_id(slot: int) -> int:
+    """The object id of clutter slot ``slot`` (body ``object_<slot>``) in the camera's id images: ``slot + 1``
+    (id 0 is the background and the support)."""
+    return slot + 1
+
+
+@dataclass(frozen=True)
+class ScenePerceived:
+    """The planner's view of a clutter scene before one attempt.
+
+    poses : slot -> (4, 4) world pose the planner is given for that object. observation : what the camera
+    saw of the whole scene (every object, id :func:`slot_id`), ``target_id`` unset (0): each plan request
+    gets a copy naming its target; None without a camera. errors : slot -> pose errors of the registered
+    pose (``trans_mm``, ``rot_deg``, ``adds_mm``, ``fitness``); empty unless ``perception.source=depth``.
+    """
+
+    poses: dict[int, np.ndarray]
+    observation: Observation | None = None
+    errors: dict[int, dict[str, float]] = field(default_factory=dict)
+
+
+def perceive_scene(
+    cfg: JobConfig,
+    objects: dict[int, tuple[ObjectModel, np.ndarray]],
+    table_z: float,
+    seed: int,
+) -> ScenePerceived:
+    """The planner's view of the clutter scene ``objects`` (slot -> (model, true (4, 4) world pose)) over the
+    support at ``table_z``: each pose the noisy truth (``perception.noise``, drawn per slot from ``seed``);
+    with a camera (:func:`wants_camera`) one observation of every object at its true pose, and with
+    ``perception.source=depth`` each object's pose registered from it (its own points only: what its
+    neighbours hide is missing) from its noisy prior, as :func:`perceive` does for one object."""
+    noise = cfg.perception.noise
+    priors = {
+        slot: perceived_pose(true, noise.trans_mm, noise.rot_deg, rng_for(seed, "noise", slot))
+        for slot, (_, true) in objects.items()
+    }
+    if not wants_camera(cfg):
+        return ScenePerceived(priors)
+    from graspexp.perception.observe import estimate_pose, observe
+    from graspexp.perception.registration import pose_errors
+
+    meshes = [MeshBody(model.mesh, true, slot_id(slot)) for slot, (model, true) in objects.items()]
+    boxes = support_boxes(table_z, tuple(cfg.mode.support_half_size_m))
+    obs = observe(cfg.perception, meshes, boxes, table_z, 0, rng=rng_for(seed, "camera"))
+    if cfg.perception.source != "depth":
+        return ScenePerceived(priors, obs)
+    poses, errors = {}, {}
+    for slot, (model, true) in objects.items():
+        start = None if cfg.perception.registration.prior == "none" else priors[slot]
+        reg = estimate_pose(
+            cfg.perception,
+            dataclasses.replace(obs, target_id=slot_id(slot)),
+            model.points,
+            model.normals,
+            start,
+            rng=rng_for(seed, "registration", slot),
+        )
+        poses[slot] = reg.pose
+        errors[slot] = {**pose_errors(reg.pose, true, model.points), "fitness": reg.fitness}
+    return ScenePerceived(poses, obs, errors)

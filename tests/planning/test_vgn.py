@@ -244,3 +244,39 @@ def test_a_plan_on_a_rendered_ycb_object_straddles_it(data_root):
     req = _request(obs)
     g = plan(req).grasp
     assert _straddles(g, req, mesh, pose), g
+
+
+def test_vgn_plans_each_object_of_a_three_object_pile_from_one_observation():
+    """A clutter scene (mode=pile; a mug, a banana and a box 1 cm apart): the camera sees all three
+    (:func:`graspexp.sim.perceive.perceive_scene`), each request names its target, and VGN's grasp for a
+    target holds that target between its pads, the same grasp every time."""
+    from graspexp.run.job_config import make_ready
+    from graspexp.run.objects import load_object
+    from graspexp.sim.perceive import perceive_scene, slot_id
+    from graspexp.sim.trial import plain_config
+
+    cfg = compose_cfg("mode=pile", "planner=vgn", "gripper=panda", "dataset=primitives")
+    make_ready(cfg)
+    plain = plain_config(cfg)
+    table_z = float(plain.mode.support_height_m)
+    models = [load_object(cfg, name, plain).model for name in ("mug", "banana", "box")]
+    objects, x = {}, -0.1
+    for slot, model in enumerate(models):
+        lo, hi = model.mesh.bounds
+        pose = np.eye(4)
+        pose[:3, 3] = [x - lo[0], -(lo[1] + hi[1]) / 2, table_z - lo[2]]
+        objects[slot] = (model, pose)
+        x += hi[0] - lo[0] + 0.01
+    view = perceive_scene(plain, objects, table_z, seed=5)
+    assert set(np.unique(view.observation.point_ids)) == {0, 1, 2, 3}
+
+    def grasp_for(slot):
+        obs = dataclasses.replace(view.observation, target_id=slot_id(slot))
+        req = dataclasses.replace(_request(obs, 7), table_z=table_z, object_pose=view.poses[slot])
+        return plan(req).grasp
+
+    for slot, (model, pose) in objects.items():
+        grasp = grasp_for(slot)
+        truth = model.points @ pose[:3, :3].T + pose[:3, 3]
+        assert vgn.target_points_between_pads(grasp.pose, grasp.width_m, plain.gripper, truth) > 0
+        assert np.array_equal(grasp.pose, grasp_for(slot).pose)
