@@ -30,9 +30,10 @@ import numpy as np
 
 from graspexp.config import GripperConfig
 from graspexp.grippers import GripperGeometry
+from graspexp.planning.cells import CellCloud, cell_cloud
 from graspexp.planning.hull_sweep import hull_cloud_hits, hull_lowest_z
 from graspexp.planning.kernels import COUNT_ALL, box_lowest_z, swept_box_hits
-from graspexp.planning.neighbour_kernels import between_pads_hits
+from graspexp.planning.neighbour_kernels import cells_swept_hits
 from graspexp.planning.pose import slab_spans_m
 
 
@@ -107,7 +108,7 @@ def cloud_hits(
 
 
 def neighbour_hits(
-    points_m: np.ndarray,
+    obstacles: CellCloud | np.ndarray,
     poses: np.ndarray,
     gripper: GripperConfig,
     widths_m: np.ndarray,
@@ -116,18 +117,43 @@ def neighbour_hits(
     margin_m: float,
 ) -> np.ndarray:
     """(B,) bool: whether the opened gripper, swept ``sweep_m`` along its approach, meets a point of the other
-    objects' cloud ``points_m`` ((N, 3) world m) of a clutter round: in the finger and palm volumes
-    (:func:`cloud_hits`) or between the pads (the fingers would close on it together with the target):
-    ``|x| <= fw/2``, ``|y| < w/2``, ``z`` from the swept palm face to the fingertips, grown by ``margin_m``."""
+    objects' cloud ``obstacles`` (cubed once per scene, :class:`graspexp.planning.cells.CellCloud`, or (N, 3)
+    world m) of a clutter round: in the finger and palm volumes (:func:`cloud_hits`) or between the pads (the
+    fingers would close on it together with the target): ``|x| <= fw/2``, ``|y| < w/2``, ``z`` from the swept
+    palm face to the fingertips, grown by ``margin_m``. Compiled (:func:`graspexp.planning.neighbour_kernels.
+    cells_swept_hits`: only the cubes near a grasp's volumes are scanned)."""
+    cells = obstacles if isinstance(obstacles, CellCloud) else cell_cloud(obstacles)
     poses = np.ascontiguousarray(np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4))
     widths = np.broadcast_to(np.asarray(widths_m, dtype=np.float64), (len(poses),))
-    if len(points_m) == 0 or len(poses) == 0:
+    if len(cells.points) == 0 or len(poses) == 0:
         return np.zeros(len(poses), dtype=bool)
-    out = cloud_hits(points_m, poses, gripper, widths, sweep_m=sweep_m, margin_m=margin_m, stop_at=1) > 0
     g, m = GripperGeometry.of(gripper), margin_m
-    box = np.array([g.finger_width_m / 2 + m, g.root_z_m - sweep_m - m, g.tip_z_m + m])
-    pts = np.ascontiguousarray(points_m, dtype=np.float64)
-    out |= between_pads_hits(pts, poses, np.ascontiguousarray(widths / 2), box)
+    fw, t = g.finger_width_m, g.finger_thickness_m
+    px, py, pz = g.palm_size_m
+    root, tip = g.root_z_m, g.tip_z_m
+    pads = np.array([fw / 2 + m, root - sweep_m - m, tip + m])
+    finger = np.array([fw / 2 + m, t, root - sweep_m - m, tip + m, m])
+    palm = np.array([px / 2 + m, py / 2 + m, root - pz - sweep_m - m, root + m])
+    half = np.ascontiguousarray(widths / 2)
+    boxes = g.hand is None
+    out = cells_swept_hits(
+        cells.points, cells.starts, cells.centres, cells.radii, poses, half, finger, palm, pads, boxes
+    )
+    if not boxes:  # a URDF hand's pieces: every point against its hulls
+        rest = ~out
+        if rest.any():
+            out[rest] = (
+                cloud_hits(
+                    cells.points,
+                    poses[rest],
+                    gripper,
+                    widths[rest],
+                    sweep_m=sweep_m,
+                    margin_m=margin_m,
+                    stop_at=1,
+                )
+                > 0
+            )
     return out
 
 
@@ -227,7 +253,7 @@ def place_grasps(
     clearance_m: float,
     max_lift_m: float,
     min_widths_m: np.ndarray | float = 0.0,
-    obstacles_m: np.ndarray | None = None,
+    obstacles_m: CellCloud | np.ndarray | None = None,
 ) -> Placement:
     """Open, lift and check a batch of candidate grasps against the cloud and the support.
 
@@ -241,7 +267,7 @@ def place_grasps(
        ``table_z + margin_m`` (below support), or when :func:`cloud_hits` finds a point (collides), or
        :func:`neighbour_hits` a point of ``obstacles_m`` (the other objects of a clutter round).
 
-    points_m : (N, 3) world cloud; poses : (B, 4, 4) world candidate poses; obstacles_m : (M, 3) world or None.
+    points_m : (N, 3) world cloud; poses : (B, 4, 4) world candidate poses; obstacles_m : (M, 3) world, cubed (:class:`CellCloud`) or not, or None.
     """
     poses = np.array(poses, dtype=np.float64).reshape(-1, 4, 4)
     b = len(poses)
@@ -280,7 +306,7 @@ def place_grasps(
         hits[check] = cloud_hits(
             points_m, poses[check], gripper, widths[check], sweep_m=sweep_m, margin_m=margin_m, stop_at=1
         )
-        if obstacles_m is not None and len(obstacles_m):
+        if obstacles_m is not None:
             hits[check] += neighbour_hits(
                 obstacles_m, poses[check], gripper, widths[check], sweep_m=sweep_m, margin_m=margin_m
             )
@@ -322,5 +348,5 @@ def place_for_request(req, poses: np.ndarray, min_widths_m: np.ndarray | float =
         clearance_m=pl.width_clearance_m,
         max_lift_m=max_lift_m(gr),
         min_widths_m=min_widths_m,
-        obstacles_m=req.neighbour_points if req.neighbours else None,
+        obstacles_m=req.neighbour_cells if req.neighbours else None,
     )

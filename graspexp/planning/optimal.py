@@ -69,6 +69,11 @@ LITERAL_NAME = "optimal_literal"
 WIDTH_CHECK_BATCHES = (1, 8, 32)
 """Paths checked per batch by the lazy section test of step 7: the cheapest alone (it fits about half
 the time on the Table 1 objects), then the next 8 (about 90 % cumulative), then 32 at a time."""
+MAX_SPECULATIVE_PATHS = 256
+"""The batches of :data:`WIDTH_CHECK_BATCHES` are tested in fewer array passes: the first ones together
+(1 + 8 + 32 paths), then as many as were examined before, up to this many (among neighbours every path may
+be examined); their tests are kept batch by batch up to the first with a passing path, so the result is
+that of one batch at a time, and a pass costs far more than the paths it tests."""
 
 
 def kmeans_random_state(seed: int, planner_seed: int) -> int:
@@ -297,6 +302,11 @@ class PathTests:
     alone: np.ndarray
     relaxed: np.ndarray
 
+    def keep(self, other: "PathTests", ks: np.ndarray, ps: np.ndarray) -> None:
+        """Copy ``other``'s tests of the paths ``(ks, ps)`` (B,) into these, in place (not ``relaxed``)."""
+        for name in ("spans", "section", "share", "free", "alone"):
+            getattr(self, name)[ks, ps] = getattr(other, name)[ks, ps]
+
     @classmethod
     def empty(cls, k: int, m: int) -> "PathTests":
         return cls(
@@ -322,16 +332,28 @@ def _choose_path(
     k, m = costs.shape
     need = float(pl.min_contacts_in_area)
     order = np.argsort(costs, axis=None, kind="stable")[: int(cand.feasible.sum())]
-    start, n_batches = 0, 0
-    while start < len(order):
-        size = WIDTH_CHECK_BATCHES[min(n_batches, len(WIDTH_CHECK_BATCHES) - 1)]
-        batch = order[start : start + size]
-        start, n_batches = start + len(batch), n_batches + 1
-        ks, ps = np.unravel_index(batch, (k, m))
+    bounds = np.cumsum([0, *WIDTH_CHECK_BATCHES])
+    last = WIDTH_CHECK_BATCHES[-1]
+    bounds = np.r_[bounds[bounds < len(order)], np.arange(bounds[-1], len(order), last), len(order)]
+    scratch = PathTests.empty(k, m)
+    b = 0
+    while b < len(bounds) - 1:
+        # tested together: the first batches (up to the size of the last), then as many as were examined
+        # before (at most MAX_SPECULATIVE_PATHS); kept batch by batch up to the first with a passing path
+        reach = max(min(2 * bounds[b], bounds[b] + MAX_SPECULATIVE_PATHS), sum(WIDTH_CHECK_BATCHES))
+        end = min(max(int(np.searchsorted(bounds, reach, "right")) - 1, b + 1), len(bounds) - 1)
+        chunk = order[bounds[b] : bounds[end]]
+        ks, ps = np.unravel_index(chunk, (k, m))
         rots = grasp_rotations(directions[ks, ps], cand.pose_axis)
-        fit = np.flatnonzero(_test_batch(req, cand, openings, tests, ks, ps, rots))
-        if len(fit):
-            return (int(ks[fit[0]]), int(ps[fit[0]])), rots[fit[0]], need
+        passing = _test_batch(req, cand, openings, scratch, ks, ps, rots)
+        for j in range(b, end):
+            rows = slice(bounds[j] - bounds[b], bounds[j + 1] - bounds[b])
+            tests.keep(scratch, ks[rows], ps[rows])
+            fit = np.flatnonzero(passing[rows])
+            if len(fit):
+                i = rows.start + fit[0]
+                return (int(ks[i]), int(ps[i])), rots[i], need
+        b = end
     # Every path above the support was examined and none passed. Fallbacks: a section that fits the
     # stroke (opened to the section), then, in pl.fallback_modes, the largest in-area share reached.
     section, share = tests.section, tests.share
@@ -405,7 +427,7 @@ def _test_batch(
         if req.neighbours:
             tests.alone[ks, ps] = free
             free &= ~neighbour_hits(
-                req.neighbour_points, poses, gr, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0
+                req.neighbour_cells, poses, gr, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0
             )
         tests.free[ks, ps] = free
         ok &= free

@@ -15,6 +15,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from graspexp.planning.neighbour_kernels import occupancy_grid, paths_clear
+
 GOLDEN_ANGLE_RAD = np.pi * (3.0 - np.sqrt(5.0))
 """Azimuth increment of the Fibonacci lattice, radians (about 137.5 degrees)."""
 
@@ -77,6 +79,10 @@ def above_support(
     return sphere_points(centers_m, directions, sphere_radius_m)[..., 2] >= table_z_m + clearance_m
 
 
+MAX_GRID_CELLS = 1 << 26
+"""Largest occupancy grid (:func:`clear_of`), cubes (64 MB); past it the obstacle's sorted cube keys serve."""
+
+
 def clear_of(
     centers_m: np.ndarray,
     radii_m: np.ndarray,
@@ -89,18 +95,24 @@ def clear_of(
     cube of side ``voxel_m`` (m) of the obstacle cloud ``obstacle_m`` ((N, 3) world m: the other objects of a
     clutter round). The path is sampled every ``voxel_m / 2`` from the sphere point to ``radii_m`` (K,) m
     (the cluster radius r_k) from the centre: nearer, the fingers close about the target, and what they may
-    meet there is the swept check's to judge."""
+    meet there is the swept check's to judge. Compiled (:func:`graspexp.planning.neighbour_kernels.
+    paths_clear`, an occupancy grid, each path's scan ending at its first occupied cube)."""
     k, m = directions.shape[:2]
     if len(obstacle_m) == 0:
         return np.ones((k, m), dtype=bool)
-    occupied = np.unique(_cube_keys(obstacle_m, voxel_m))
     n = int(np.ceil(sphere_radius_m / (voxel_m / 2))) + 1
     frac = np.linspace(0.0, 1.0, n)
     start = np.minimum(np.asarray(radii_m, dtype=np.float64), sphere_radius_m)
     steps = start[:, None] + frac[None, :] * (sphere_radius_m - start[:, None])  # (K, S) m from the centre
-    samples = (
-        centers_m[:, None, None, :] - steps[:, None, :, None] * directions[:, :, None, :]
-    )  # (K, M, S, 3)
+    obstacle = np.ascontiguousarray(obstacle_m, dtype=np.float64)
+    grid, first = occupancy_grid(obstacle, voxel_m, MAX_GRID_CELLS)
+    centers = np.ascontiguousarray(centers_m, dtype=np.float64)
+    if grid.size:
+        return paths_clear(
+            centers, steps, np.ascontiguousarray(directions, dtype=np.float64), grid, first, voxel_m
+        )
+    occupied = np.unique(_cube_keys(obstacle, voxel_m))
+    samples = centers[:, None, None, :] - steps[:, None, :, None] * directions[:, :, None, :]  # (K, M, S, 3)
     keys = _cube_keys(samples.reshape(-1, 3), voxel_m)
     at = np.minimum(np.searchsorted(occupied, keys), len(occupied) - 1)
     return ~(occupied[at] == keys).reshape(k, m, n).any(axis=2)

@@ -7,6 +7,7 @@ import numpy as np
 
 from graspexp.config import CostConfig, GripperConfig, PlannerConfig
 from graspexp.perception.observation import Observation
+from graspexp.planning.cells import CellCloud, cell_cloud
 from graspexp.planning.details import PaperDetails
 from graspexp.planning.grasp import Grasp
 
@@ -71,12 +72,15 @@ class PlanRequest:
             return np.zeros((0, 3))
         return np.concatenate([np.asarray(n.points, dtype=np.float64) for n in self.neighbours])
 
+    @cached_property
+    def neighbour_cells(self) -> CellCloud:
+        """:attr:`neighbour_points` sorted into cubes (:func:`graspexp.planning.cells.cell_cloud`), built once
+        per request for every swept test of its paths."""
+        return cell_cloud(self.neighbour_points)
+
 
 @dataclass(frozen=True)
 class PlanResult:
-    """A grasp plus every intermediate a figure or test may want: a typed record
-    (:mod:`graspexp.planning.details`) for the paper's planners, a dict of arrays for the others."""
-
     grasp: Grasp
     details: PaperDetails | dict[str, np.ndarray] = field(default_factory=dict)
 
