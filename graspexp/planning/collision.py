@@ -332,11 +332,13 @@ def max_lift_m(gripper: GripperConfig) -> float:
     return MAX_LIFT_FRACTION * GripperGeometry.of(gripper).tip_z_m
 
 
-def place_for_request(req, poses: np.ndarray, min_widths_m: np.ndarray | float = 0.0) -> Placement:
+def place_for_request(
+    req, poses: np.ndarray, min_widths_m: np.ndarray | float = 0.0, *, neighbours: bool = True
+) -> Placement:
     """:func:`place_grasps` with the request's cloud, support plane, gripper and planner settings
     (sweep = ``planner.sphere_radius_m``, ``collision_margin_m``, ``width_clearance_m``). A support that
     does not block the gripper (``req.support_blocks_gripper`` False) is not checked; a clutter round's other
-    objects (``req.neighbours``) are obstacles (:func:`neighbour_hits`)."""
+    objects (``req.neighbours``) are obstacles (:func:`neighbour_hits`) unless ``neighbours`` is False."""
     pl, gr = req.planner, req.gripper
     return place_grasps(
         np.asarray(req.points, dtype=np.float64),
@@ -348,5 +350,5 @@ def place_for_request(req, poses: np.ndarray, min_widths_m: np.ndarray | float =
         clearance_m=pl.width_clearance_m,
         max_lift_m=max_lift_m(gr),
         min_widths_m=min_widths_m,
-        obstacles_m=req.neighbour_cells if req.neighbours else None,
+        obstacles_m=req.neighbour_cells if req.neighbours and neighbours else None,
     )

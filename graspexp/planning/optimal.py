@@ -103,7 +103,15 @@ class Candidates:
 
 
 def paper_candidates(req: PlanRequest, planner: str, cluster_length_m: float | None = None) -> Candidates:
-    """Grasping area -> main axis -> K-means -> Fibonacci paths -> support test -> cost, as in section III.
+    """Grasping area -> main axis -> K-means -> Fibonacci paths -> support test -> cost, as in section III,
+    among a clutter round's neighbours (:func:`among_neighbours`) when the request has any.
+    ``planner`` and ``cluster_length_m`` as in :func:`target_candidates`."""
+    cand = target_candidates(req, planner, cluster_length_m)
+    return among_neighbours(req, cand, planner) if req.neighbours else cand
+
+
+def target_candidates(req: PlanRequest, planner: str, cluster_length_m: float | None = None) -> Candidates:
+    """:func:`paper_candidates` for the target alone (its neighbours, if any, not looked at).
 
     ``planner`` names the caller in error messages. ``cluster_length_m``: the length along the main axis
     that ``k: auto`` gives each cluster, m (None: ``planner.auto_k_stroke_fraction`` of the stroke). Raises NoFeasibleGrasp for an empty area or when every
@@ -144,21 +152,28 @@ def paper_candidates(req: PlanRequest, planner: str, cluster_length_m: float | N
             f"{planner}: every one of the {k * m} paths starts below the support plane z = "
             f"{req.table_z + pl.table_clearance_m:.4f} m (sphere radius {pl.sphere_radius_m} m)"
         )
-    if req.neighbours:  # III-D's rule for the support, for the other objects of a clutter round
-        feasible &= clear_of(
-            centers,
-            clusters.radii_m,
-            directions,
-            pl.sphere_radius_m,
-            req.neighbour_points,
-            pl.neighbour_voxel_m,
-        )
-        if not feasible.any():
-            raise NoFeasibleGrasp(
-                f"{planner}: every one of the {k * m} paths passes through the support or another object"
-            )
     costs = path_costs(req, points, axis, clusters, directions, feasible)
     return Candidates(points, mask, axis, pose_axis, clusters, directions, feasible, costs)
+
+
+def among_neighbours(req: PlanRequest, cand: Candidates, planner: str) -> Candidates:
+    """``cand`` (planned for the target alone) with the paths through a clutter round's other objects removed
+    (step 5, III-D's rule for the support; :func:`.paths.clear_of`, ``planner.neighbour_voxel_m``): not
+    feasible, cost inf. A path's cost depends on that path only, so these are the costs planned among the
+    neighbours. Raises NoFeasibleGrasp when every path is removed."""
+    pl = req.planner
+    clusters = cand.clusters
+    clear = clear_of(
+        clusters.centers_m, clusters.radii_m, cand.directions, pl.sphere_radius_m, req.neighbour_points,
+        pl.neighbour_voxel_m,
+    )  # fmt: skip
+    feasible = cand.feasible & clear
+    if not feasible.any():
+        k, m = feasible.shape
+        raise NoFeasibleGrasp(
+            f"{planner}: every one of the {k * m} paths passes through the support or another object"
+        )
+    return replace(cand, feasible=feasible, costs=np.where(feasible, cand.costs, np.inf))
 
 
 def paper_details(

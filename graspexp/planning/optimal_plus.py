@@ -59,11 +59,11 @@ from graspexp.core.geometry import transform_points
 from graspexp.core.seeding import rng_for
 from graspexp.grippers import GripperGeometry
 from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
-from graspexp.planning.collision import Placement, cloud_hits, place_for_request
+from graspexp.planning.collision import Placement, cloud_hits, neighbour_hits, place_for_request
 from graspexp.planning.details import Candidate, OptimalPlusDetails, Shortlist
 from graspexp.planning.friction import cone_cosine
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
-from graspexp.planning.optimal import paper_candidates, paper_details
+from graspexp.planning.optimal import Candidates, among_neighbours, paper_details, target_candidates
 from graspexp.planning.pose import grasp_rotations, opening_widths_m
 from graspexp.planning.request import PlanRequest, PlanResult
 from graspexp.planning.stability import (
@@ -95,42 +95,47 @@ def _check_params(pl) -> None:
 def plan_optimal_plus(req: PlanRequest) -> PlanResult:
     """Plan one grasp with the paper's candidates and the checks of the module doc. In a clutter round, when
     no grasp clears the neighbours and ``planner.neighbour_fallback`` is on, the grasp planned for the target
-    alone (touching a neighbour is allowed; ``extras["touches_neighbours"]``).
+    alone (touching a neighbour is allowed; ``extras["touches_neighbours"]``). Both searches read one
+    :class:`_TryTable`: a try is placed and tested once.
 
     Raises
     ------
     NoFeasibleGrasp
         Empty grasping area; every path crosses the support plane; or no path passes checks 1-3.
     """
-    try:
-        result = _plan(req)
-    except NoFeasibleGrasp:
-        if not (req.neighbours and req.planner.neighbour_fallback):
-            raise
-        result = _plan(dataclasses.replace(req, neighbours=()))
-        result.grasp.extras["touches_neighbours"] = True
-        return result
-    if req.neighbours:
-        result.grasp.extras["touches_neighbours"] = False
-    return result
-
-
-def _plan(req: PlanRequest) -> PlanResult:
-    """:func:`plan_optimal_plus` with the request's neighbours as obstacles (none: one object)."""
     pl, gr = req.planner, req.gripper
     _check_params(pl)
     geometry = GripperGeometry.of(gr)
     length = geometry.finger_width_m if pl.cluster_length == "finger_width" else None
-    cand = paper_candidates(req, NAME, cluster_length_m=length)
+    alone = target_candidates(req, NAME, cluster_length_m=length)
+    if pl.opening == "cluster":  # (K,) smallest openings, m: the paper's 2 r_k rule
+        floors = opening_widths_m(alone.clusters.radii_m, pl.width_margin, gr)
+    else:
+        floors = np.zeros(len(alone.clusters.radii_m))
+    table = _TryTable(req, alone, geometry, floors)
+    com = volume_centroid_m(alone.points)
+    if not req.neighbours:
+        return _plan(req, alone, table, com)
+    try:
+        result = _plan(req, among_neighbours(req, alone, NAME), table, com)
+    except NoFeasibleGrasp:
+        if not pl.neighbour_fallback:
+            raise
+        result = _plan(dataclasses.replace(req, neighbours=()), alone, table, com)
+        result.grasp.extras["touches_neighbours"] = True
+        return result
+    result.grasp.extras["touches_neighbours"] = False
+    return result
+
+
+def _plan(req: PlanRequest, cand: Candidates, table: "_TryTable", com: np.ndarray) -> PlanResult:
+    """:func:`plan_optimal_plus` over the paths of ``cand``, with the request's neighbours as obstacles (none:
+    one object); ``com`` (3,) the cloud's centre of mass, world m."""
+    pl, gr, geometry = req.planner, req.gripper, table.geometry
     points = cand.points
     k, m = cand.costs.shape
-    com = volume_centroid_m(points)
     size = max(float(np.linalg.norm(points.max(axis=0) - points.min(axis=0))), 1e-9)
-    if pl.opening == "cluster":  # (K,) smallest openings, m: the paper's 2 r_k rule
-        floors = opening_widths_m(cand.clusters.radii_m, pl.width_margin, gr)
-    else:
-        floors = np.zeros(k)
-    tries = _Tries(req, cand, geometry, floors)
+    tries = _Tries(table, cand, bool(req.neighbours))
     passed, rejected, examined, best_share = _search_paths(pl, tries, pl.min_contacts_in_area)
     in_area_required = pl.min_contacts_in_area
     if not passed and (share := fallback_share(req, best_share)) is not None:  # step 6 of the module doc
@@ -221,36 +226,38 @@ class _Batch:
     share: np.ndarray
 
 
-class _Tries:
-    """The tries of the paper's paths in ascending cost (module doc, steps 1-3 but the area test), evaluated
-    on demand and kept: a fallback search (step 7) reads them again. Paths are evaluated in chunks that
-    grow with the search (:data:`PATH_BATCH` up to :data:`MAX_CHUNK` paths), so a long search makes few
-    array passes; each chunk is kept as :class:`_Batch` es of :data:`PATH_BATCH` paths."""
+class _TryTable:
+    """The tries of every path of a request (module doc, steps 1-3 but the area test; path-major, then roll
+    (R), then depth offset (O)), each placed and tested once, when a search first asks for its path: placed
+    against the target and the support (:func:`graspexp.planning.collision.place_for_request` without
+    neighbours), then, where that clears, against the neighbours (:func:`graspexp.planning.collision.
+    neighbour_hits`), and the pads (step 3) where a search needs them. A search among the neighbours and
+    one for the target alone (the fallback) read the same tries; every try's result is that of a
+    placement of its own, so it does not depend on which paths were placed with it."""
 
-    def __init__(self, req: PlanRequest, cand, geometry: GripperGeometry, floors: np.ndarray):
+    def __init__(self, req: PlanRequest, cand: Candidates, geometry: GripperGeometry, floors: np.ndarray):
         pl = req.planner
         self.req, self.cand, self.geometry, self.floors = req, cand, geometry, floors
         self.offsets = np.asarray(pl.depth_offsets_m, dtype=np.float64)
         self.rolls = [_roll(np.deg2rad(r)) for r in pl.rolls_deg]
-        self.order = np.argsort(cand.costs, axis=None, kind="stable")[: int(cand.feasible.sum())]
-        self.n_batches = -(-len(self.order) // PATH_BATCH)
-        self.batches: list[_Batch] = []
+        n, t = cand.costs.size, len(self.rolls) * len(self.offsets)
+        self.done = np.zeros(n, dtype=bool)
+        self.poses = np.empty((n, t, 4, 4))
+        self.widths, self.lift = np.empty((n, t)), np.empty((n, t))
+        self.too_wide, self.below, self.check = (np.empty((n, t), dtype=bool) for _ in range(3))
+        self.collides, self.neighbour_hit = np.empty((n, t), dtype=bool), np.zeros((n, t), dtype=bool)
+        self.hit_done, self.padded = np.zeros((n, t), dtype=bool), np.zeros((n, t), dtype=bool)
+        self.held, self.depth, self.share = np.zeros((n, t), dtype=bool), np.empty((n, t)), np.empty((n, t))
 
-    def batch(self, i: int) -> _Batch:
-        """The ``i``-th batch of :data:`PATH_BATCH` paths (``i < n_batches``)."""
-        while len(self.batches) <= i:
-            done = len(self.batches) * PATH_BATCH
-            size = min(max(done, PATH_BATCH), MAX_CHUNK)
-            self._evaluate(self.order[done : done + size])
-        return self.batches[i]
-
-    def _evaluate(self, chunk: np.ndarray) -> None:
-        """Place and test the tries of the paths ``chunk`` (flat indices into the (K, M) costs); append
-        their batches."""
+    def place(self, paths: np.ndarray) -> None:
+        """Place the tries of the paths ``paths`` (flat indices into the (K, M) costs) not placed yet, against
+        the target and the support."""
+        new = paths[~self.done[paths]]
+        if not len(new):
+            return
         req, cand, offsets = self.req, self.cand, self.offsets
-        pl = req.planner
         n_roll, n_off = len(self.rolls), len(offsets)
-        ks, ps = np.unravel_index(chunk, cand.costs.shape)
+        ks, ps = np.unravel_index(new, cand.costs.shape)
         b, centers = len(ks), cand.clusters.centers_m
         rots = grasp_rotations(cand.directions[ks, ps], cand.pose_axis)  # (B, 3, 3)
         poses = np.tile(np.eye(4), (b, n_roll, n_off, 1, 1))
@@ -259,29 +266,98 @@ class _Tries:
         poses[..., :3, 3] = (
             centers[ks][:, None, None] + offsets[None, None, :, None] * rots[:, None, None, :, 2]
         )
-        placed = place_for_request(req, poses.reshape(-1, 4, 4), np.repeat(self.floors[ks], n_roll * n_off))
-        depth = np.full(len(placed.ok), -np.inf)
-        held = np.zeros(len(placed.ok), dtype=bool)
-        share = np.zeros(len(placed.ok))
-        if placed.ok.any():
+        placed = place_for_request(
+            req, poses.reshape(-1, 4, 4), np.repeat(self.floors[ks], n_roll * n_off), neighbours=False
+        )
+        shape = (b, n_roll * n_off)
+        self.poses[new] = placed.poses.reshape(*shape, 4, 4)
+        self.widths[new], self.lift[new] = placed.widths_m.reshape(shape), placed.lift_m.reshape(shape)
+        self.too_wide[new], self.below[new] = (
+            placed.too_wide.reshape(shape),
+            placed.below_support.reshape(shape),
+        )
+        self.check[new] = (~placed.too_wide & ~placed.below_support).reshape(shape)
+        self.collides[new] = placed.collides.reshape(shape)
+        self.done[new] = True
+
+    def _ok(self, paths: np.ndarray, neighbours: bool) -> tuple[np.ndarray, np.ndarray]:
+        """(P, T) collisions and passing tries of the placed paths ``paths``, among the neighbours or not;
+        the neighbours and the pads (step 3) tested here where not yet."""
+        req = self.req
+        if neighbours:
+            todo = self.check[paths] & ~self.collides[paths] & ~self.hit_done[paths]
+            if todo.any():
+                rows, cols = np.nonzero(todo)
+                at = (paths[rows], cols)
+                self.neighbour_hit[at] = neighbour_hits(
+                    req.neighbour_cells, self.poses[at], req.gripper, self.widths[at],
+                    sweep_m=req.planner.sphere_radius_m, margin_m=req.planner.collision_margin_m,
+                )  # fmt: skip
+                self.hit_done[at] = True
+        collides = self.collides[paths] | (self.neighbour_hit[paths] if neighbours else False)
+        ok = self.check[paths] & ~collides
+        todo = ok & ~self.padded[paths]
+        if todo.any():
+            rows, cols = np.nonzero(todo)
+            at = (paths[rows], cols)
             normals = np.asarray(req.normals, dtype=np.float64)
-            held[placed.ok], depth[placed.ok], share[placed.ok] = _pads_hold(
-                pl, self.geometry, cand.points, normals, cand.area_mask, placed.poses[placed.ok]
+            self.held[at], self.depth[at], self.share[at] = _pads_hold(
+                req.planner, self.geometry, self.cand.points, normals, self.cand.area_mask, self.poses[at]
             )
-        held &= placed.ok
-        per = n_roll * n_off
-        for s in range(0, b, PATH_BATCH):
-            t = slice(s * per, (s + PATH_BATCH) * per)
-            self.batches.append(
-                _Batch(
-                    ks[s : s + PATH_BATCH],
-                    ps[s : s + PATH_BATCH],
-                    placed.rows(t),
-                    held[t],
-                    depth[t],
-                    share[t],
-                )
-            )
+            self.padded[at] = True
+        return collides, ok
+
+    def prepare(self, paths: np.ndarray, neighbours: bool) -> None:
+        """Place the paths ``paths`` not placed yet and test their tries (:meth:`batch`) in one pass."""
+        self.place(paths)
+        self._ok(paths, neighbours)
+
+    def batch(self, paths: np.ndarray, neighbours: bool) -> "_Batch":
+        """The tries of the placed paths ``paths`` as a :class:`_Batch`, among the neighbours (their hits
+        are collisions) or not."""
+        collides, ok = self._ok(paths, neighbours)
+        ks, ps = np.unravel_index(paths, self.cand.costs.shape)
+        flat = ok.reshape(-1)
+        placed = Placement(
+            poses=self.poses[paths].reshape(-1, 4, 4),
+            widths_m=self.widths[paths].reshape(-1),
+            lift_m=self.lift[paths].reshape(-1),
+            ok=flat,
+            too_wide=self.too_wide[paths].reshape(-1),
+            below_support=self.below[paths].reshape(-1),
+            collides=(self.check[paths] & collides).reshape(-1),
+        )
+        held = self.held[paths].reshape(-1) & flat
+        depth = np.where(flat, self.depth[paths].reshape(-1), -np.inf)
+        share = np.where(flat, self.share[paths].reshape(-1), 0.0)
+        return _Batch(ks, ps, placed, held, depth, share)
+
+
+class _Tries:
+    """The tries of the paths of one search (``cand``'s, in ascending cost; module doc, steps 1-3 but the
+    area test), read from ``table`` as :class:`_Batch` es of :data:`PATH_BATCH` paths, among the neighbours
+    or not (``neighbours``). Paths are placed in chunks that grow with the search (:data:`PATH_BATCH` up to
+    :data:`MAX_CHUNK` paths), so a long search makes few array passes; a fallback search (step 7) reads the
+    batches again."""
+
+    def __init__(self, table: _TryTable, cand: Candidates, neighbours: bool):
+        self.table, self.neighbours = table, neighbours
+        self.offsets, self.rolls = table.offsets, table.rolls
+        self.order = np.argsort(cand.costs, axis=None, kind="stable")[: int(cand.feasible.sum())]
+        self.n_batches = -(-len(self.order) // PATH_BATCH)
+        self.batches: list[_Batch] = []
+        self.placed = 0
+
+    def batch(self, i: int) -> _Batch:
+        """The ``i``-th batch of :data:`PATH_BATCH` paths (``i < n_batches``)."""
+        while len(self.batches) <= i:
+            start = len(self.batches) * PATH_BATCH
+            if start >= self.placed:
+                size = min(max(start, PATH_BATCH), MAX_CHUNK)
+                self.table.prepare(self.order[start : start + size], self.neighbours)
+                self.placed = start + size
+            self.batches.append(self.table.batch(self.order[start : start + PATH_BATCH], self.neighbours))
+        return self.batches[i]
 
 
 def _search_paths(pl, tries: _Tries, min_share: float) -> tuple[list[Candidate], dict[str, int], int, float]:
