@@ -95,9 +95,9 @@ def scene_latency(scenes: list[list], planner: str, repeats: int) -> tuple[list[
     planner_cfg = plain_config(cfg).planner
     walls, cpus = [], []
     for requests in scenes:
-        reqs = [dataclasses.replace(r, planner=planner_cfg) for r in requests]
         w, c = [], []
-        for _ in range(repeats):
+        for _ in range(repeats):  # new requests each time: what a request builds once is timed in each repeat
+            reqs = [dataclasses.replace(r, planner=planner_cfg) for r in requests]
             t0, c0 = time.perf_counter(), time.thread_time()
             for req in reqs:
                 try:
