@@ -11,6 +11,7 @@ from helpers.planning import TABLE_Z, plain_cfg, resting_cloud
 
 from graspexp.planning import plan
 from graspexp.planning.collision import neighbour_hits
+from graspexp.planning.grasp import NoFeasibleGrasp
 from graspexp.planning.paths import clear_of
 from graspexp.planning.request import Neighbour, PlanRequest
 
@@ -91,3 +92,23 @@ def test_neighbours_between_the_pads_count():
     far = np.array([[0.5, 0.5, 0.0]])
     assert neighbour_hits(inside, pose[None], cfg.gripper, np.array([0.08]), sweep_m=0.1, margin_m=0.0)[0]
     assert not neighbour_hits(far, pose[None], cfg.gripper, np.array([0.08]), sweep_m=0.1, margin_m=0.0)[0]
+
+
+@pytest.mark.parametrize("planner", ["optimal", "optimal_plus"])
+def test_enclosed_target_falls_back_to_its_plan_alone(planner):
+    """A neighbour shell around the target blocks every path: with ``planner.neighbour_fallback`` the
+    grasp is the one planned for the target alone (optimal_plus) or a path clear of target and support
+    (optimal), flagged as touching; without it, no grasp."""
+    req = _request(planner, ())
+    shell = trimesh.creation.box([0.09, 0.11, 0.15]).sample(6000, seed=5) + [0.0, 0.0, TABLE_Z + 0.05]
+    shell = shell[shell[:, 2] > TABLE_Z + 0.005]
+    boxed = dataclasses.replace(req, neighbours=(Neighbour(1, "shell", shell, np.eye(4)),))
+    grasp = plan(boxed).grasp
+    assert grasp.extras["touches_neighbours"]
+    if planner == "optimal_plus":
+        alone = plan(req).grasp
+        np.testing.assert_array_equal(grasp.pose, alone.pose)
+        assert (grasp.width_m, grasp.cost, grasp.n_feasible) == (alone.width_m, alone.cost, alone.n_feasible)
+    strict = dataclasses.replace(boxed, planner=dataclasses.replace(boxed.planner, neighbour_fallback=False))
+    with pytest.raises(NoFeasibleGrasp):
+        plan(strict)
