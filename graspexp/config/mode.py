@@ -63,6 +63,15 @@ class ModeConfig:
     the order a person follows, and only one plan is paid per attempt when it succeeds). Planners that plan on
     the camera (``vgn``, ``antipodal_view``) follow the same rule: each object in turn is the observation's
     ``target_id`` (vgn: the detections that hold it, cost 1 - quality)."""
+    sleep_threshold: float = 0.0
+    """``pile``/``packed``: PhysX sleep threshold of the round's objects, m^2/s^2: a body whose mass-normalised
+    kinetic energy stays below it for PhysX's wake counter (0.4 s) is put to sleep, skipped by the solver
+    until an awake body touches it or one it rests on is removed. 0: never, as the bodies of every trial
+    (``sim`` sets 0 for all). 0.005, PhysX's default, lets the untouched objects of a heap sleep through an
+    attempt and ends the settling sooner: a logged pile attempt cost about 0.6x the CPU time
+    (``bench.clutter``), but a body moving slower than about 0.1 m/s for 0.4 s is frozen where it is, and the
+    rounds' outcomes differ (docs/guide/clutter.md#speed); below 0.001 a heap's contact jitter keeps its
+    objects awake (no gain measured). Off by default: the results are those of the full physics."""
 
 
 CLUTTER_MODES = ("pile", "packed")
@@ -88,5 +97,6 @@ CONSTRAINTS = {
     "drop_height_m": [Interval(0, 2, unit="m")],
     "placement_gap_m": [Interval(0, 1, unit="m")],
     "pick_order": [Options(PICK_ORDERS)],
+    "sleep_threshold": [Interval(0, 1, unit="m^2/s^2")],
 }
 """Allowed values of every key (see :mod:`graspexp.config.constraints`)."""

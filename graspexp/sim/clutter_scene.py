@@ -79,6 +79,8 @@ def add_clutter_object(
     entity, body = add_object(
         ts.scene, shape, model.mass_kg, pose, cfg.sim, model.friction, name, CLUTTER_OBJECT_MASK
     )
+    if cfg.mode.sleep_threshold > 0:  # else PhysX's body default of the whole sim: never asleep
+        body.sleep_threshold = float(cfg.mode.sleep_threshold)
     ts.bodies[name] = (entity, body)
     if ts.object_entity is None:
         ts.target(name)

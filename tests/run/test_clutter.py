@@ -20,6 +20,7 @@ from graspexp.run.job_config import make_ready
 from graspexp.run.objects import load_object
 from graspexp.run.round_loop import draw_objects
 from graspexp.sim.clutter import RoundContext, RoundObject, run_round
+from graspexp.sim.clutter_scene import add_clutter_object, clutter_scene
 from graspexp.sim.trial import plain_config
 
 
@@ -193,3 +194,21 @@ def test_truth_rounds_record_no_pose_error():
     res = _round("packed", ["can", "box"], _no_grasp)
     (row,) = res.attempt_rows()
     assert np.isnan(row.pose_adds_mm) and np.isnan(row.registration_fitness)
+
+
+@pytest.mark.parametrize("threshold", [0.0, 0.005])
+def test_objects_of_a_round_sleep_only_with_a_sleep_threshold(threshold):
+    """``mode.sleep_threshold``: a box resting on the table is put to sleep by PhysX after its wake counter
+    (0.4 s) with a threshold, never without one (every trial's default)."""
+    cfg = compose_cfg("mode=packed", "dataset=primitives", f"mode.sleep_threshold={threshold}")
+    make_ready(cfg)
+    plain = plain_config(cfg)
+    box = load_object(cfg, "box", plain)
+    ts = clutter_scene(plain.mode, plain)
+    rest = make_pose(np.eye(3), [0.0, 0.0, ts.table_z - float(box.model.points[:, 2].min())])
+    add_clutter_object(ts, "object_0", box.model, box.hulls, rest, plain)
+    body = ts.bodies["object_0"][1]
+    assert body.sleep_threshold == pytest.approx(threshold)
+    for _ in range(int(1.5 / plain.sim.timestep_s)):
+        ts.scene.step()
+    assert body.is_sleeping == (threshold > 0)
