@@ -29,11 +29,12 @@ def cells_swept_hits(
     palm: np.ndarray,
     pads: np.ndarray,
     boxes: bool,
+    between: bool,
 ) -> np.ndarray:
     """(B,) bool: whether a point of the cubed cloud (:class:`graspexp.planning.cells.CellCloud`: points,
     starts, centres, radii) lies, in the frame of a grasp (poses (B, 4, 4) world, half openings
-    half_widths (B,) m), between the pads: ``|x| <= pads[0]``, ``|y| < half_widths[g]``, ``pads[1] <= z <=
-    pads[2]``, or, with ``boxes``, in the swept finger and palm boxes of
+    half_widths (B,) m), with ``between``, between the pads: ``|x| <= pads[0]``, ``|y| < half_widths[g]``,
+    ``pads[1] <= z <= pads[2]``, or, with ``boxes``, in the swept finger and palm boxes of
     :func:`graspexp.planning.kernels.swept_box_hits` (finger [half x, thickness, z lo, z hi, margin], palm
     [half x, half y, z lo, z hi]). A cube whose bounding sphere misses the union of those boxes is skipped;
     the others' points get the exact tests, the same expressions as a scan of every point, so the result
@@ -47,7 +48,7 @@ def cells_swept_hits(
         tx, ty, tz, h = r[0, 3], r[1, 3], r[2, 3], half_widths[g]
         y0, y1 = h - m, h + ft + m
         # bounds of the fingers with the gap between them (box A) and of the palm (box B), frame axes
-        ax, ay, az0, az1 = hx, h, zlo, zhi
+        ax, ay, az0, az1 = (hx, h, zlo, zhi) if between else (fx, y1, fz0, fz1)
         if boxes:
             ax, ay, az0, az1 = max(ax, fx), max(ay, y1), min(az0, fz0), max(az1, fz1)
         for c in range(centres.shape[0]):
@@ -66,7 +67,7 @@ def cells_swept_hits(
                 z = r[0, 2] * dx + r[1, 2] * dy + r[2, 2] * dz
                 x = abs(r[0, 0] * dx + r[1, 0] * dy + r[2, 0] * dz)
                 y = abs(r[0, 1] * dx + r[1, 1] * dy + r[2, 1] * dz)
-                hit = (x <= hx) & (y < h) & (zlo <= z) & (z <= zhi)
+                hit = between and (x <= hx) & (y < h) & (zlo <= z) & (z <= zhi)
                 if boxes:
                     hit |= (x <= fx) & (fz0 <= z) & (z <= fz1) & (y0 <= y) & (y <= y1)
                     hit |= (x <= px) & (y <= py) & (pz0 <= z) & (z <= pz1)

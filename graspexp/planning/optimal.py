@@ -45,6 +45,7 @@ object pose: world frame, metres):
 :class:`graspexp.planning.details.OptimalDetails` (every intermediate, with shapes and units)."""
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -52,8 +53,9 @@ from graspexp.core.geometry import make_pose
 from graspexp.core.seeding import derive_seed
 from graspexp.grippers import GripperGeometry
 from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
+from graspexp.planning.cells import CellCloud, cell_cloud
 from graspexp.planning.clusters import Clusters, choose_k, elongation, main_axis, max_radii_m, segment
-from graspexp.planning.collision import cloud_hits, lowest_z, neighbour_hits
+from graspexp.planning.collision import cells_meet, lowest_z, neighbour_hits
 from graspexp.planning.cost import all_path_costs
 from graspexp.planning.details import OptimalDetails
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
@@ -100,6 +102,11 @@ class Candidates:
     directions: np.ndarray
     feasible: np.ndarray
     costs: np.ndarray
+
+    @cached_property
+    def cells(self) -> CellCloud:
+        """``points`` sorted into cubes (:func:`graspexp.planning.cells.cell_cloud`) for the swept check."""
+        return cell_cloud(self.points)
 
 
 def paper_candidates(req: PlanRequest, planner: str, cluster_length_m: float | None = None) -> Candidates:
@@ -436,7 +443,7 @@ def _test_batch(
     if pl.swept_check:
         poses[:, :3, 3] += _centre_shifts_m(pl, spans)[:, None] * rots[:, :, 1]
         widths = _opened_widths_m(pl, gr, extent, openings[ks])
-        free = cloud_hits(points, poses, gr, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0, stop_at=1) == 0
+        free = ~cells_meet(cand.cells, poses, gr, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0)
         if req.support_blocks_gripper:
             free &= lowest_z(poses, gr, widths, pl.sphere_radius_m) >= req.table_z
         if req.neighbours:
