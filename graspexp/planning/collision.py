@@ -115,41 +115,16 @@ def neighbour_hits(
     *,
     sweep_m: float,
     margin_m: float,
+    between_pads: bool = True,
 ) -> np.ndarray:
     """(B,) bool: whether the opened gripper, swept ``sweep_m`` along its approach, meets a point of the other
     objects' cloud ``obstacles`` (cubed, :class:`graspexp.planning.cells.CellCloud`, or (N, 3) world m) of a
-    clutter round: in the finger and palm volumes (:func:`cloud_hits`) or between the pads (the fingers would
-    close on it together with the target): ``|x| <= fw/2``, ``|y| < w/2``, ``z`` from the swept palm face to
-    the fingertips, grown by ``margin_m``. Compiled (:func:`graspexp.planning.neighbour_kernels.
-    cells_swept_hits`: only the cubes near a grasp's volumes are scanned)."""
-    return _cells_hits(obstacles, poses, gripper, widths_m, sweep_m, margin_m, between=True)
-
-
-def cells_meet(
-    cells: CellCloud,
-    poses: np.ndarray,
-    gripper: GripperConfig,
-    widths_m: np.ndarray,
-    *,
-    sweep_m: float,
-    margin_m: float,
-) -> np.ndarray:
-    """(B,) bool: ``cloud_hits(cells.points, ..., stop_at=1) > 0`` (a point in the swept finger or palm
-    volumes), scanning only the cubes of the cubed cloud ``cells`` near each grasp's volumes."""
-    return _cells_hits(cells, poses, gripper, widths_m, sweep_m, margin_m, between=False)
-
-
-def _cells_hits(
-    obstacles: CellCloud | np.ndarray,
-    poses: np.ndarray,
-    gripper: GripperConfig,
-    widths_m: np.ndarray,
-    sweep_m: float,
-    margin_m: float,
-    *,
-    between: bool,
-) -> np.ndarray:
-    """:func:`neighbour_hits` (``between``: the volume between the pads counts) or :func:`cells_meet`."""
+    clutter round: in the finger and palm volumes (:func:`cloud_hits`) or, with ``between_pads``, between the
+    pads (the fingers would close on it together with the target): ``|x| <= fw/2``, ``|y| < w/2``, ``z`` from
+    the swept palm face to the fingertips, grown by ``margin_m``. Without ``between_pads`` it is
+    ``cloud_hits(..., stop_at=1) > 0`` (the target's own cloud, cubed). Compiled
+    (:func:`graspexp.planning.neighbour_kernels.cells_swept_hits`: only the cubes near a grasp's volumes are
+    scanned)."""
     cells = obstacles if isinstance(obstacles, CellCloud) else cell_cloud(obstacles)
     poses = np.ascontiguousarray(np.asarray(poses, dtype=np.float64).reshape(-1, 4, 4))
     widths = np.broadcast_to(np.asarray(widths_m, dtype=np.float64), (len(poses),))
@@ -158,7 +133,7 @@ def _cells_hits(
     g, m = GripperGeometry.of(gripper), margin_m
     if g.hand is not None:  # a URDF hand's pieces: every point against its hulls
         out = cloud_hits(cells.points, poses, gripper, widths, sweep_m=sweep_m, margin_m=m, stop_at=1) > 0
-        if not between:
+        if not between_pads:
             return out
     fw, t = g.finger_width_m, g.finger_thickness_m
     px, py, pz = g.palm_size_m
@@ -170,7 +145,7 @@ def _cells_hits(
     args = (cells.points, cells.starts, cells.centres, cells.radii, poses, half, finger, palm, pads)
     if g.hand is not None:
         return out | cells_swept_hits(*args, False, True)
-    return cells_swept_hits(*args, True, between)
+    return cells_swept_hits(*args, True, between_pads)
 
 
 def support_lift_m(

@@ -55,7 +55,7 @@ from graspexp.grippers import GripperGeometry
 from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
 from graspexp.planning.cells import CellCloud, cell_cloud
 from graspexp.planning.clusters import Clusters, choose_k, elongation, main_axis, max_radii_m, segment
-from graspexp.planning.collision import cells_meet, lowest_z, neighbour_hits
+from graspexp.planning.collision import lowest_z, neighbour_hits
 from graspexp.planning.cost import all_path_costs
 from graspexp.planning.details import OptimalDetails
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
@@ -443,7 +443,9 @@ def _test_batch(
     if pl.swept_check:
         poses[:, :3, 3] += _centre_shifts_m(pl, spans)[:, None] * rots[:, :, 1]
         widths = _opened_widths_m(pl, gr, extent, openings[ks])
-        free = ~cells_meet(cand.cells, poses, gr, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0)
+        free = ~neighbour_hits(
+            cand.cells, poses, gr, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0, between_pads=False
+        )
         if req.support_blocks_gripper:
             free &= lowest_z(poses, gr, widths, pl.sphere_radius_m) >= req.table_z
         if req.neighbours:

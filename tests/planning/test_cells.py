@@ -8,7 +8,7 @@ from helpers.planning import plain_cfg
 import graspexp.planning.paths as paths
 from graspexp.grippers import GripperGeometry
 from graspexp.planning.cells import cell_cloud
-from graspexp.planning.collision import cells_meet, cloud_hits, neighbour_hits
+from graspexp.planning.collision import cloud_hits, neighbour_hits
 from graspexp.planning.paths import approach_directions, clear_of
 
 
@@ -50,7 +50,9 @@ def test_neighbour_hits_equal_a_scan_of_every_point(gripper, margin_m):
     np.testing.assert_array_equal(got, want)
     plain = neighbour_hits(points, poses, cfg.gripper, widths, sweep_m=0.1, margin_m=margin_m)
     np.testing.assert_array_equal(plain, want)  # an uncubed cloud is cubed on the way
-    meet = cells_meet(cell_cloud(points), poses, cfg.gripper, widths, sweep_m=0.1, margin_m=margin_m)
+    meet = neighbour_hits(
+        cell_cloud(points), poses, cfg.gripper, widths, sweep_m=0.1, margin_m=margin_m, between_pads=False
+    )
     assert 0.1 < boxes.mean() < 0.9
     np.testing.assert_array_equal(meet, boxes)  # the finger and palm volumes alone
 
