@@ -68,10 +68,11 @@ class ModeConfig:
     kinetic energy stays below it for PhysX's wake counter (0.4 s) is put to sleep, skipped by the solver
     until an awake body touches it or one it rests on is removed. 0: never, as the bodies of every trial
     (``sim`` sets 0 for all). 0.005, PhysX's default, lets the untouched objects of a heap sleep through an
-    attempt and ends the settling sooner: a logged pile attempt cost about 0.6x the CPU time
+    attempt and ends the settling sooner: a logged pile attempt cost about 0.65x the CPU time
     (``bench.clutter``), but a body moving slower than about 0.1 m/s for 0.4 s is frozen where it is, and the
-    rounds' outcomes differ (docs/guide/clutter.md#speed); below 0.001 a heap's contact jitter keeps its
-    objects awake (no gain measured). Off by default: the results are those of the full physics."""
+    rounds' outcomes differ (docs/results/clutter.md, Speed); at 0.001 and below a heap's contact jitter
+    keeps its objects awake (no steady gain measured). Off by default: the results are those of the full
+    physics."""
 
 
 CLUTTER_MODES = ("pile", "packed")
