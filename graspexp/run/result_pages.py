@@ -302,9 +302,10 @@ def _clutter(sweep: Sweep) -> Callable[[PageInput], str]:
 
 
 CLUTTER_CAMERA_ROUNDS = 50
-"""Rounds per planner and scene of the camera clutter page: 50, not the exact-pose page's 100 (5 rounds of
-every row took 36 s CPU per round of all rows on the 2-core machine: 100 rounds would take about an hour of
-CPU while other jobs share it)."""
+"""Rounds per planner and scene of the camera clutter page: 50, not the exact-pose page's 100. Measured on the
+shared 2-core machine (3-round runs, CPU per round, pile / packed): optimal 3.7 / 2.4 s, optimal_plus
+4.6 / 2.6 s, antipodal_view 7.8 / 6.2 s, vgn about 2 s: about 37 s per round of all eight rows, an hour of
+CPU for 100 rounds."""
 CLUTTER_CAMERA_COMMON = (
     "mode=pile,packed",
     *REGISTERED,
