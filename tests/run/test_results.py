@@ -208,11 +208,11 @@ def test_the_camera_and_learned_pages_fingerprint_jobs_compose(name):
     page = next(p for p in PAGES if p.name == name)
     jobs = fingerprint_jobs(page)
     assert 0 < len(jobs) <= 10
-    for job in jobs:
-        cfg = compose_config(list(job))
+    cfgs = {job: compose_config(list(job)) for job in jobs}
+    for job, cfg in cfgs.items():
         assert cfg.record is False and int(cfg.trials) == 1, job
         assert set(cfg.objects) <= set(TABLE1.labels) and cfg.dataset.name == "ycb", job
-    planners = {compose_config(list(j)).planner.name for j in jobs}
+    planners = {cfg.planner.name for cfg in cfgs.values()}
     assert "vgn" in planners and (name == "learned" or {"optimal", "antipodal_view"} <= planners)
 
 

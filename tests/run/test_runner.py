@@ -40,6 +40,7 @@ def _snapshot(folder: Path) -> dict[str, bytes]:
     return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
 
 
+@pytest.mark.slow
 def test_resume_refuses_logs_made_with_another_config(run_copy: Path) -> None:
     log = run_copy / "trials" / "can" / "000.mcap"
     before = log.read_bytes()
