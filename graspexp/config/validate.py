@@ -138,19 +138,7 @@ def validate(cfg: DictConfig | Any) -> None:
     _check_node(cfg, job.JobConfig, "")
     _check_relations(cfg)
     _check_split(cfg)
-    _check_clutter(cfg)
     _check_camera_extra(cfg)
-
-
-def _check_clutter(cfg: DictConfig) -> None:
-    """A clutter round (``mode=pile``/``packed``) is not shown live yet: one line."""
-    name = OmegaConf.select(cfg, "mode.name")
-    if name not in mode.CLUTTER_MODES:
-        return
-    if OmegaConf.select(cfg, "live") is True:
-        raise ConfigError(
-            f"live=true is not available with mode={name} yet: its log opens in Foxglove afterwards"
-        )
 
 
 def _check_camera_extra(cfg: DictConfig) -> None:

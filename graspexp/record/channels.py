@@ -42,6 +42,16 @@ class Channels:
         }
         self._camera: CameraChannels | None = None
 
+    def use_bodies(self, bodies: tuple[str, ...]) -> None:
+        """Name the /contacts bodies of the next log on these channels (a live server's serve one trial or
+        clutter round after another): the channel is re-created, with its new metadata, when they differ."""
+        if bodies != self.bodies:
+            self.contacts.close()
+            self.contacts = PointCloudChannel(
+                S.TOPIC_CONTACTS, metadata={"bodies": ",".join(bodies)}, context=self.context
+            )
+            self.bodies = bodies
+
     def lazy_json(self, topic: str) -> foxglove.Channel:
         """The JSON channel of one of :data:`graspexp.record.schemas.LAZY_TOPICS`, created on first use."""
         if topic not in self.json:

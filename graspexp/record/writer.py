@@ -186,7 +186,8 @@ class TrialWriter:
         if bad:
             raise TypeError(f"metadata must map str to str; offending keys: {bad}")
         self._ch = channels if channels is not None else Channels(foxglove.Context(), bodies)
-        self._bodies = self._ch.bodies
+        self._ch.use_bodies(bodies)
+        self._bodies = bodies
         self._mcap = None
         if stream is not None:
             options = MCAPWriteOptions(

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from graspexp.core.clutter import RoundResult
+from graspexp.report.clutter import clutter_table, table_markdown
 from graspexp.report.compare import FC_MU, check_same_drops, render_markdown
 from graspexp.report.compare import success_by_noise as noise_success_table
 from graspexp.report.contact_area import IN_AREA_TOLERANCE_M
@@ -128,4 +130,47 @@ def summary_lines(
     failures = failure_breakdown(zero)
     failures.to_csv(out / "failures.csv", index=False)
     lines += ["", "## Failure reasons (zero pose noise)", "", markdown(failures, index=False), ""]
+    return lines
+
+
+def same_rounds(rounds: list[RoundResult]) -> bool:
+    """True when every planner ran the same rounds (round index, seed and objects drawn) in each dataset and
+    scene: a ranking of planners on the same heaps."""
+    drawn: dict[tuple[str, str], dict[str, set]] = {}
+    for r in rounds:
+        key = (r.dataset, r.mode)
+        drawn.setdefault(key, {}).setdefault(r.planner, set()).add((r.round, r.seed, tuple(r.drawn)))
+    return all(len({frozenset(v) for v in by_planner.values()}) == 1 for by_planner in drawn.values())
+
+
+def clutter_lines(levels: dict[tuple[float, float], list[RoundResult]], out: Path) -> list[str]:
+    """The Markdown sections of a benchmark in the clutter modes: per dataset and scene the planners ranked
+    at zero pose noise by DR (objects cleared), then GSR; then every pose-noise level (``levels``: (mm,
+    degrees) -> its rounds). Writes ``clutter_ranking.csv`` (every level) into ``out``."""
+    lines, tables = [], []
+    for (t, r), rounds in levels.items():
+        table = clutter_table(rounds)
+        if table.empty:
+            continue
+        table = table.sort_values(
+            ["dataset", "mode", "DR_%", "GSR_%", "planner"], ascending=[True, True, False, False, True]
+        )
+        tables.append(table.assign(trans_mm=t, rot_deg=r))
+        if (t, r) == (0.0, 0.0):
+            for (dataset, mode), g in table.groupby(["dataset", "mode"], sort=True):
+                lines += [f"## Ranking on `{dataset}`, clutter removal `{mode}` (zero pose noise)", ""]
+                lines += [table_markdown(g), ""]
+            lines += [
+                "Ranked by DR (objects removed / objects placed), then GSR (successful / executed attempts), "
+                "each with its Wilson 95 % interval; plan time: every plan of an attempt (ms).",
+                "",
+                "Same heaps: every planner ran the same rounds (seed and objects drawn) in each scene."
+                if same_rounds(rounds)
+                else "The planners did not all run the same rounds: compare with care.",
+                "",
+            ]
+        else:
+            lines += [f"## Clutter removal at pose noise {t:g} mm / {r:g} deg", "", table_markdown(table), ""]
+    if tables:
+        pd.concat(tables, ignore_index=True).to_csv(out / "clutter_ranking.csv", index=False)
     return lines

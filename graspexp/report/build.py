@@ -24,6 +24,7 @@ from graspexp.report.agreement import Agreement, agreement, agreement_chart, exa
 from graspexp.report.charts import success_chart
 from graspexp.report.citations import DETERMINISM
 from graspexp.report.clutter import clutter_markdown, clutter_table, find_rounds
+from graspexp.report.clutter_strips import write_clutter_strips
 from graspexp.report.collect import FINGERPRINT_COLUMN, Collected, collect
 from graspexp.report.contact_area import held_in_area
 from graspexp.report.gallery import draw_trial, write_gallery
@@ -197,7 +198,8 @@ def clutter_section(rounds: list[RoundResult], out: Path) -> list[str]:
 def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 2) -> str:
     """Write every file of the report into ``out_dir``; returns the Markdown of report.md.
 
-    gallery_per_reason : example failures drawn per setting and failure reason (0: no gallery).
+    gallery_per_reason : example failures drawn per setting and failure reason (0: no gallery, and no
+        strips of the clutter rounds' failed attempts, which are all drawn otherwise).
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -225,6 +227,12 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
         md += agreement_section(ag, col.results, out)
     if report.rounds:
         md += clutter_section(report.rounds, out)
+        if gallery_per_reason > 0 and write_clutter_strips(col.root, out):
+            md += [
+                "[clutter_failures.md](clutter_failures.md): every failed attempt drawn from its round log, "
+                "when it was planned and when it ended (`clutter_failures/*.png`).",
+                "",
+            ]
     if not report.failures.empty:
         (out / "failures.md").write_text(markdown(report.failures, index=False) + "\n")
         (out / "failures.tex").write_text(latex(report.failures, "Failure reasons per setting", index=False))

@@ -135,7 +135,11 @@ def clutter_table(rounds: list[RoundResult]) -> pd.DataFrame:
 
 def clutter_markdown(rounds: list[RoundResult]) -> str:
     """The clutter table as markdown: one line per planner and scene, intervals in brackets."""
-    table = clutter_table(rounds)
+    return table_markdown(clutter_table(rounds))
+
+
+def table_markdown(table: pd.DataFrame) -> str:
+    """Rows of :func:`clutter_table` as markdown, in their order, intervals in brackets."""
     if table.empty:
         return "no clutter round finished"
     lines = [

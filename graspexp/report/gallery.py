@@ -31,7 +31,7 @@ CUBE_FACES = np.array([[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [
 """Corner indices of the six faces of a box whose corners are ordered by the bits (x, y, z)."""
 
 
-def _pose_at(log: TrialLog, frame: str, t_s: float) -> np.ndarray | None:
+def pose_at(log: TrialLog, frame: str, t_s: float) -> np.ndarray | None:
     """(4, 4) world pose of ``frame`` at the last /tf sample at or before ``t_s``; identity for world."""
     if frame == "world":
         return np.eye(4)
@@ -63,22 +63,24 @@ def _entities_at(log: TrialLog, t_s: float) -> dict[str, dict]:
     return {k: e for k, (_, e) in live.items()}
 
 
-def _polygons(log: TrialLog, t_s: float, centre: np.ndarray) -> list[tuple[np.ndarray, tuple]]:
-    """(polygon (P, 3) world m, rgba) of every shape at ``t_s``; boxes larger than the view (the support)
-    are reduced to their top face cropped to the view."""
+def _polygons(
+    log: TrialLog, t_s: float, centre: np.ndarray, half_m: float = VIEW_HALF_M
+) -> list[tuple[np.ndarray, tuple]]:
+    """(polygon (P, 3) world m, rgba) of every shape at ``t_s``; boxes larger than the view (the cube of
+    half side ``half_m`` around ``centre``: the support) are reduced to their top face cropped to it."""
     polys = []
     for ent in _entities_at(log, t_s).values():
-        frame = _pose_at(log, ent["frame_id"], t_s)
+        frame = pose_at(log, ent["frame_id"], t_s)
         if frame is None:
             continue
         for cube in ent.get("cubes", []):
             size = np.array([cube["size"][k] for k in "xyz"], dtype=float)
             pose = frame @ _local_pose(cube["pose"])
             rgba = tuple(cube["color"][k] for k in "rgba")
-            if size.max() > 2 * VIEW_HALF_M:  # the support: its top face, cropped to the view
+            if size.max() > 2 * half_m:  # the support: its top face, cropped to the view
                 top = pose[2, 3] + size[2] / 2
-                lo = np.maximum(pose[:2, 3] - size[:2] / 2, centre[:2] - VIEW_HALF_M)
-                hi = np.minimum(pose[:2, 3] + size[:2] / 2, centre[:2] + VIEW_HALF_M)
+                lo = np.maximum(pose[:2, 3] - size[:2] / 2, centre[:2] - half_m)
+                hi = np.minimum(pose[:2, 3] + size[:2] / 2, centre[:2] + half_m)
                 if (lo < hi).all():
                     quad = [
                         [lo[0], lo[1], top],
@@ -116,16 +118,31 @@ def key_times(log: TrialLog) -> dict[str, float]:
 
 
 def draw_trial(log: TrialLog, path: Path, title: str) -> Path:
-    """Draw one trial at :func:`key_times` side by side into ``path`` (PNG)."""
+    """Draw one trial at :func:`key_times` side by side into ``path`` (PNG), centred on the planned grasp
+    point (where failures happen), else on the object's origin."""
     times = key_times(log)
     grasp = log.grasp["pose"] if log.grasp is not None else None
-    fig = plt.figure(figsize=(10, 5))
+    obj = pose_at(log, "object", times["close"])
+    centre = grasp[:3, 3] if grasp is not None else obj[:3, 3] if obj is not None else np.zeros(3)
+    return draw_instants(log, times, grasp, centre, path, title)
+
+
+def draw_instants(
+    log: TrialLog,
+    times: dict[str, float],
+    grasp: np.ndarray | None,
+    centre: np.ndarray,
+    path: Path,
+    title: str,
+    half_m: float = VIEW_HALF_M,
+) -> Path:
+    """Draw the logged scene at each of ``times`` (label -> simulation s), side by side, into ``path``
+    (PNG): the cube of half side ``half_m`` around ``centre`` (3,) world m, and the grasp frame ``grasp``
+    (4, 4) world when given (the view looks along its X)."""
+    fig = plt.figure(figsize=(5 * len(times), 5))
     for j, (label, t_s) in enumerate(times.items()):
-        ax = fig.add_subplot(1, 2, j + 1, projection="3d")
-        obj = _pose_at(log, "object", t_s)
-        # Centred on the planned grasp point (where failures happen), else on the object's origin.
-        centre = grasp[:3, 3] if grasp is not None else obj[:3, 3] if obj is not None else np.zeros(3)
-        polys = _polygons(log, t_s, centre)
+        ax = fig.add_subplot(1, len(times), j + 1, projection="3d")
+        polys = _polygons(log, t_s, centre, half_m)
         if polys:
             coll = Poly3DCollection([p for p, _ in polys], facecolors=[c for _, c in polys], linewidths=0.1)
             coll.set_edgecolor((0, 0, 0, 0.15))
@@ -137,7 +154,7 @@ def draw_trial(log: TrialLog, path: Path, title: str) -> Path:
             x = grasp[:3, 0]
             ax.view_init(elev=20, azim=float(np.degrees(np.arctan2(x[1], x[0]))))
         for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre, strict=True):
-            setter(c - VIEW_HALF_M, c + VIEW_HALF_M)
+            setter(c - half_m, c + half_m)
         ax.set_box_aspect((1, 1, 1))
         ax.set_title(f"{label}, t = {t_s:.2f} s", fontsize=9)
         ax.tick_params(labelsize=6)

@@ -13,9 +13,12 @@ from pathlib import Path
 
 import pandas as pd
 
+from graspexp.config.mode import CLUTTER_MODES
 from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
+from graspexp.core.clutter import RoundResult
 from graspexp.core.run_layout import SUMMARY_MD, results_csv
-from graspexp.report.benchmark import summary_lines
+from graspexp.report.benchmark import clutter_lines, summary_lines
+from graspexp.report.clutter import ROUNDS_CSV, find_rounds
 from graspexp.report.collect import collect
 from graspexp.report.contact_area import finger_contacts_in_area
 from graspexp.report.paper import PAPER_TABLES, SETTINGS, TRIALS_PER_SETTING
@@ -118,9 +121,19 @@ def run_all(bench: Benchmark, todo: list[Job]) -> list[str]:
     for planner_jobs in by_planner.values():
         rc = subprocess.call(sweep_command(bench, planner_jobs))
         for job in planner_jobs:
-            if not results_csv(job.run_dir).is_file():
+            done = Path(job.run_dir) / ROUNDS_CSV if job.mode in CLUTTER_MODES else results_csv(job.run_dir)
+            if not done.is_file():
                 errors.append(f"{job.run_dir}: no results (the sweep of {job.planner} exited {rc})")
     return errors
+
+
+def clutter_rounds(all_jobs: list[Job]) -> dict[tuple[float, float], list[RoundResult]]:
+    """The rounds of the clutter jobs, per pose-noise level (mm, degrees), zero first."""
+    levels: dict[tuple[float, float], list[RoundResult]] = {}
+    for job in all_jobs:
+        if job.mode in CLUTTER_MODES and Path(job.run_dir).is_dir():
+            levels.setdefault((job.trans_mm, job.rot_deg), []).extend(find_rounds(job.run_dir))
+    return dict(sorted(levels.items(), key=lambda kv: kv[0] != (0.0, 0.0)))
 
 
 def results(all_jobs: list[Job]) -> pd.DataFrame:
@@ -173,12 +186,14 @@ def write_summary(
     out = Path(bench.out) / bench.planner
     out.mkdir(parents=True, exist_ok=True)
     df = results(all_jobs)
+    rounds = clutter_rounds(all_jobs)
     lines = [f"# Benchmark: planner `{bench.planner}`", ""]
-    if df.empty:
+    if df.empty and not any(rounds.values()):
         lines.append("No readable trial logs.")
-    else:
+    if not df.empty:
         planners = [bench.planner, *compared(bench)]
         lines += summary_lines(df, bench.planner, planners, bench.datasets, bench.settings, out)
+    lines += clutter_lines(rounds, out)
     if errors:
         lines += ["## Jobs that did not finish", "", *(f"- {e}" for e in errors), ""]
     text = "\n".join(lines) + "\n"

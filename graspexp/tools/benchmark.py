@@ -12,7 +12,8 @@ entered; ``dataset=`` one dataset or several (``dataset=ycb,linemod``, the defau
 ``sim.*``, ...) to every planner. Options:
 
 - ``mode=collab,bin`` / ``rot=z,xyz``: the settings, every combination of the values given (default the
-  paper's four);
+  paper's four); ``mode=pile,packed``: clutter removal, ``trials=`` rounds per scene, the planners ranked
+  by DR then GSR on the same heaps (``clutter_ranking.csv``; the drop rotation is not read there);
 - ``--noise 10:0,0:10``: pose-noise levels ``trans_mm:rot_deg`` besides zero (``--noise ''``: none);
 - ``--compare obb,random``: planners ranked beside it (default the built-in ones; they run too where
   their results are missing, once, and are reused by every later entrant);
@@ -39,6 +40,7 @@ import yaml
 from omegaconf import OmegaConf
 
 from graspexp.config import ConfigError, PluginError
+from graspexp.config.mode import CLUTTER_MODES
 from graspexp.config.plugins import get_plugin
 from graspexp.run.benchmark import Benchmark, jobs, run_all, write_summary
 from graspexp.run.suites import PAPER_MODES, PAPER_ROTS
@@ -98,7 +100,15 @@ def parse_args(argv: list[str]) -> Benchmark:
     if "planner" not in values:
         raise ConfigError("planner is missing: python -m graspexp benchmark planner=NAME [dataset=...]")
     modes, rots = values.pop("mode", None), values.pop("rot", None)
-    if modes or rots:  # every combination of the given modes and rotations, in the paper's order
+    clutter = [m for m in modes or [] if m in CLUTTER_MODES]
+    if clutter and len(clutter) < len(modes):
+        raise ConfigError(
+            f"mode={','.join(modes)}: the clutter modes ({', '.join(CLUTTER_MODES)}) rank on rounds (DR, GSR), "
+            "the others on trials; benchmark them in two commands"
+        )
+    if clutter:  # the drop rotation is not read by the clutter modes: one job per scene
+        values["settings"] = [f"{m}/{PAPER_ROTS[0]}" for m in clutter]
+    elif modes or rots:  # every combination of the given modes and rotations, in the paper's order
         values["settings"] = [f"{m}/{r}" for m in (modes or PAPER_MODES) for r in (rots or PAPER_ROTS)]
     options = ("noise", "compare", "out", "n_jobs", "launcher", "slurm_partition", "timeout_min")
     return Benchmark(**values, **{k: getattr(args, k) for k in options if getattr(args, k) is not None})

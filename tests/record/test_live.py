@@ -5,6 +5,7 @@ import base64
 import json
 import struct
 
+import pytest
 import websockets
 from mcap.records import Schema
 from mcap_protobuf.decoder import DecoderFactory
@@ -64,3 +65,30 @@ def test_live_off_by_default_starts_nothing():
     assert cfg.live is False
     with trial_recorder(None, {}, cfg) as rec:
         assert isinstance(rec, NullRecorder)
+
+
+def test_a_clutter_round_streams_live_with_its_own_body_names():
+    """The live server serves a trial, then a clutter round (one /contacts body per object), then a trial
+    again: each log's contacts are named by its own bodies, in the live channel's metadata too."""
+    from graspexp.record.live import live_channels
+    from graspexp.record.scene import round_bodies
+
+    cfg = plain_config(compose_config(["mode=pile", "live=true", "live_port=0"]))
+    contact = {
+        "body0": "object_2",
+        "body1": "tray",
+        "position": (0, 0, 0),
+        "normal": (0, 0, 1),
+        "force_n": 1.0,
+    }
+    try:
+        with trial_recorder(None, {}, cfg) as rec:  # a single-object trial: no object_2
+            with pytest.raises(ValueError, match="'object_2' is not one of"):
+                rec.contacts(0.0, [contact])
+        with trial_recorder(None, {}, cfg, round_bodies(3)) as rec:
+            rec.contacts(0.0, [contact])
+        assert live_channels(0).contacts.metadata()["bodies"] == ",".join(round_bodies(3))
+        with trial_recorder(None, {}, cfg) as rec:
+            assert live_channels(0).contacts.metadata()["bodies"].split(",")[0] == "object"
+    finally:
+        stop_live(0)

@@ -45,3 +45,34 @@ def test_the_tables_have_one_row_per_round_and_per_attempt():
     assert len(rounds_frame(rounds)) == 2 and len(attempts_frame(rounds)) == 6
     text = clutter_markdown(rounds)
     assert "| optimal | pile | ycb | 2 | 80.0 [" in text and "dropped 1" in text
+
+
+@pytest.mark.slow
+def test_every_failed_attempt_of_a_logged_round_gets_a_picture_strip(tmp_path):
+    """A logged pile round whose grasps close on air: each failed attempt is drawn from the round log (the
+    one that found no grasp once), listed with its log; the report links the strips."""
+    from helpers.config import compose_cfg
+
+    from graspexp.record import read_round
+    from graspexp.report.build import build_report, write_report
+    from graspexp.report.clutter_strips import write_clutter_strips
+    from graspexp.run.runner import run_in_dir
+
+    cfg = compose_cfg(
+        "mode=pile", "dataset=primitives", "objects=[can,box]", "mode.objects_per_round=2", "trials=1",
+        "progress=false", "planner=random",
+    )  # fmt: skip
+    run_in_dir(cfg, tmp_path / "run")
+    attempts = read_round(tmp_path / "run" / "trials" / "pile" / "000.mcap")["attempts"]
+    failed = [a for a in attempts if not a["success"]]
+    assert failed, "the random planner's round should fail at least once"
+    text = write_clutter_strips(tmp_path / "run", tmp_path / "out")
+    pngs = sorted((tmp_path / "out" / "clutter_failures").glob("*.png"))
+    assert len(pngs) == len(failed) and text == (tmp_path / "out" / "clutter_failures.md").read_text()
+    for a in failed:
+        name = f"primitives_random_pile_r000_a{a['attempt']}_{a['reason']}"
+        assert f"![{name}](clutter_failures/{name}.png)" in text
+    assert "000.mcap`" in text
+    report = write_report(build_report(tmp_path / "run", progress=False), tmp_path / "report")
+    assert "[clutter_failures.md](clutter_failures.md)" in report
+    assert write_clutter_strips(tmp_path / "empty", tmp_path / "none") == ""  # no round log: nothing drawn

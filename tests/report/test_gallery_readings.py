@@ -8,7 +8,7 @@ import pytest
 from helpers.cli import ok, run_job
 
 from graspexp.record import read_trial
-from graspexp.report import collect
+from graspexp.report.collect import collect
 from graspexp.report.gallery import _entities_at, key_times, pick_examples, write_gallery
 from graspexp.report.readings import MixedConfigError, readings_report
 from graspexp.run.suites import ALL, READINGS, reading_sweep

@@ -12,10 +12,12 @@ from helpers.logs import foreign_log
 from graspexp.core.outcome import FailureReason, TrialResult
 from graspexp.datasets import dataset_objects
 from graspexp.record import TrialRecorder
-from graspexp.report import build_report, collect, wilson_interval, write_report
 from graspexp.report.agreement import p_below
+from graspexp.report.build import build_report, write_report
+from graspexp.report.collect import collect
 from graspexp.report.paper import BASELINES, SETTINGS, TABLE1, TABLE2
 from graspexp.report.render import display_frame, latex_escape
+from graspexp.report.stats import wilson_interval
 from graspexp.tools.report import main as report_main
 
 # ---------------------------------------------------------------- Wilson interval (hand-computed)

@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 from helpers.cli import ok, run
 
-from graspexp.report import collect
+from graspexp.report.collect import collect
 from graspexp.run.jobs import job_dir_name
 from graspexp.run.multirun import multirun_command
 

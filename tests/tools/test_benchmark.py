@@ -112,3 +112,47 @@ def test_n_jobs_below_one_is_refused_before_any_work(capsys):
         parse_args(["planner=obb", "--n-jobs", "0"])
     assert exc.value.code == 2
     assert "argument --n-jobs: expected an integer >= 1, got 0" in capsys.readouterr().err
+
+
+def test_the_clutter_modes_run_one_job_per_scene_and_rank_planners_by_dr_then_gsr(tmp_path):
+    from graspexp.core.clutter import AttemptResult, RoundResult
+    from graspexp.report.benchmark import clutter_lines, same_rounds
+
+    bench = parse_args(["planner=obb", "mode=pile,packed", "rot=xyz", "--noise", ""])
+    assert bench.settings == ["pile/z", "packed/z"]  # the drop rotation is not read by the clutter modes
+    with pytest.raises(ConfigError, match="rank on rounds"):
+        parse_args(["planner=obb", "mode=pile,bin"])
+
+    def rounds(planner, removed, seeds=(1, 2)):
+        def attempts(r, n):
+            return [
+                AttemptResult(round=r, attempt=i, target="a", slot=i, executed=True, success=i < n,
+                              reason=None if i < n else "dropped", pick_order="lowest_cost", n_left=2 - i,
+                              n_planned=2 - i, plan_s=0.01, plan_cpu_s=0.01).to_dict()
+                for i in range(n + 1)
+            ]  # fmt: skip
+
+        return [
+            RoundResult(
+                "ycb",
+                "pile",
+                planner,
+                r,
+                seed,
+                ["a", "b"],
+                ["object_0", "object_1"],
+                ["object_0", "object_1"][:n],
+                "failure_limit",
+                attempts(r, n),
+            )  # fmt: skip
+            for r, (seed, n) in enumerate(zip(seeds, removed, strict=True))
+        ]
+
+    both = rounds("obb", [1, 1]) + rounds("optimal", [2, 2])
+    lines = "\n".join(clutter_lines({(0.0, 0.0): both, (10.0, 0.0): both}, tmp_path))
+    ranking = lines.split("## Ranking on `ycb`, clutter removal `pile` (zero pose noise)")[1]
+    assert ranking.index("| optimal |") < ranking.index("| obb |")  # DR 100 % before 50 %
+    assert "Same heaps" in lines and "## Clutter removal at pose noise 10 mm / 0 deg" in lines
+    csv = pd.read_csv(tmp_path / "clutter_ranking.csv")
+    assert list(csv["planner"][:2]) == ["optimal", "obb"] and set(csv["trans_mm"]) == {0.0, 10.0}
+    assert not same_rounds(rounds("obb", [1, 1]) + rounds("optimal", [2, 2], seeds=(1, 3)))
