@@ -15,7 +15,7 @@ nox.options.reuse_existing_virtualenvs = True
 HERE = Path(__file__).parent
 DATA = os.environ.get("GRASPEXP_DATA", str((HERE / ".." / "shared" / "datasets").resolve()))
 ENV = {"GRASPEXP_DATA": DATA, "OMP_NUM_THREADS": "1"}
-LEARNED_PAGES = ("camera", "learned")
+LEARNED_PAGES = ("camera", "learned", "clutter_camera")
 """The results pages whose sweeps run a learned planner (``planner=vgn``): ``nox -s learned`` checks them."""
 CHECKPOINTS = os.environ.get("GRASPEXP_CHECKPOINTS", str((Path(DATA) / ".." / "peers" / "vgn").resolve()))
 """The published checkpoints the learned planners' tests read (``../shared/peers/vgn``; never copied)."""

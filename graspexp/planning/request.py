@@ -49,6 +49,10 @@ class PlanRequest:
         the model placed at the registered pose (or the true one with ``perception.source=truth``).
     neighbours : the other objects on the support in a clutter round (empty for one object): obstacles
         for the paths and the swept gripper; a planner that ignores them still plans for the target.
+    workspace_xy : (2, 2) [[x_min, y_min], [x_max, y_max]] world m, the clutter mode's workspace
+        (``mode.workspace_half_size_m`` about the support's centre) in a clutter round; None for one
+        object. A planner that sees the scene as one volume (``vgn``) places it there, the same for every
+        target of the scene.
     """
 
     points: np.ndarray
@@ -64,6 +68,7 @@ class PlanRequest:
     support_blocks_gripper: bool = True
     observation: Observation | None = None
     neighbours: tuple[Neighbour, ...] = ()
+    workspace_xy: np.ndarray | None = None
 
     @cached_property
     def neighbour_points(self) -> np.ndarray:

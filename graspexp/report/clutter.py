@@ -162,3 +162,27 @@ def table_markdown(table: pd.DataFrame) -> str:
             f"| {r['plan_p50_ms']:.1f} / {r['plan_p95_ms']:.1f} | {ends} | {fails or '-'} |"
         )
     return "\n".join(lines)
+
+
+def registration_markdown(rounds: list[RoundResult]) -> str:
+    """Per planner and scene, the error of the pose registered from the camera for the target of every
+    executed attempt (``perception.source=depth``): ADD-S p50/p95 (mm), translation and rotation error p50
+    (mm, deg). Attempts without a registered pose (exact poses) are left out."""
+    att = attempts_frame(rounds)
+    if att.empty or "pose_adds_mm" not in att:
+        return "no attempt with a registered pose"
+    att = att[att["executed"].astype(bool) & pd.to_numeric(att["pose_adds_mm"], errors="coerce").notna()]
+    if att.empty:
+        return "no attempt with a registered pose"
+    lines = [
+        "| planner | scene | dataset | attempts | ADD-S p50 / p95 mm | translation p50 mm | rotation p50 deg |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for (planner, mode, dataset), g in att.groupby(["planner", "mode", "dataset"], sort=True):
+        adds = percentiles(g["pose_adds_mm"].astype(float))
+        trans = percentiles(g["pose_trans_err_mm"].astype(float))[0]
+        rot = percentiles(g["pose_rot_err_deg"].astype(float))[0]
+        lines.append(
+            f"| {planner} | {mode} | {dataset} | {len(g)} | {adds[0]:.1f} / {adds[1]:.1f} | {trans:.1f} | {rot:.1f} |"
+        )
+    return "\n".join(lines)

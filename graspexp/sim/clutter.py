@@ -310,6 +310,8 @@ def _plan_scene(
     order = sorted(seen)
     if cfg.mode.pick_order == "top_most":
         order.sort(key=lambda b: -float(seen[b][2][:, 2].max()))
+    half = np.asarray(cfg.mode.workspace_half_size_m, dtype=np.float64)
+    workspace_xy = np.stack([-half, half])  # about the support's centre, world x = y = 0
     plans: list[tuple[float, int, str, Grasp]] = []
     wall, cpu, n = 0.0, 0.0, 0
     with sim.timed("plan"):
@@ -336,6 +338,7 @@ def _plan_scene(
                 observation=None
                 if view.observation is None
                 else dataclasses.replace(view.observation, target_id=slot_id(slot)),
+                workspace_xy=workspace_xy,
             )
             t0, c0 = time.perf_counter(), time.thread_time()
             try:

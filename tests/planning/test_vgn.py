@@ -246,13 +246,13 @@ def test_a_plan_on_a_rendered_ycb_object_straddles_it(data_root):
     assert _straddles(g, req, mesh, pose), g
 
 
-def test_vgn_plans_each_object_of_a_three_object_pile_from_one_observation():
-    """A clutter scene (mode=pile; a mug, a banana and a box 1 cm apart): the camera sees all three
-    (:func:`graspexp.sim.perceive.perceive_scene`), each request names its target, and VGN's grasp for a
-    target holds that target between its pads, the same grasp every time."""
+def _three_in_a_row(x0: float, y: float):
+    """A clutter scene (mode=pile; a mug, a banana and a box 1 cm apart in a row along x from ``x0``, centred
+    on ``y``, m) seen by the camera (:func:`graspexp.sim.perceive.perceive_scene`): the plain config, the
+    support height, slot -> (model, pose) and the scene's view."""
     from graspexp.run.job_config import make_ready
     from graspexp.run.objects import load_object
-    from graspexp.sim.perceive import perceive_scene, slot_id
+    from graspexp.sim.perceive import perceive_scene
     from graspexp.sim.trial import plain_config
 
     cfg = compose_cfg("mode=pile", "planner=vgn", "gripper=panda", "dataset=primitives")
@@ -260,14 +260,23 @@ def test_vgn_plans_each_object_of_a_three_object_pile_from_one_observation():
     plain = plain_config(cfg)
     table_z = float(plain.mode.support_height_m)
     models = [load_object(cfg, name, plain).model for name in ("mug", "banana", "box")]
-    objects, x = {}, -0.1
+    objects, x = {}, x0
     for slot, model in enumerate(models):
         lo, hi = model.mesh.bounds
         pose = np.eye(4)
-        pose[:3, 3] = [x - lo[0], -(lo[1] + hi[1]) / 2, table_z - lo[2]]
+        pose[:3, 3] = [x - lo[0], y - (lo[1] + hi[1]) / 2, table_z - lo[2]]
         objects[slot] = (model, pose)
         x += hi[0] - lo[0] + 0.01
-    view = perceive_scene(plain, objects, table_z, seed=5)
+    return plain, table_z, objects, perceive_scene(plain, objects, table_z, seed=5)
+
+
+def test_vgn_plans_each_object_of_a_three_object_pile_from_one_observation():
+    """A clutter scene (mode=pile; a mug, a banana and a box 1 cm apart): the camera sees all three
+    (:func:`graspexp.sim.perceive.perceive_scene`), each request names its target, and VGN's grasp for a
+    target holds that target between its pads, the same grasp every time."""
+    from graspexp.sim.perceive import slot_id
+
+    plain, table_z, objects, view = _three_in_a_row(-0.1, 0.0)
     assert set(np.unique(view.observation.point_ids)) == {0, 1, 2, 3}
 
     def grasp_for(slot):
@@ -280,3 +289,61 @@ def test_vgn_plans_each_object_of_a_three_object_pile_from_one_observation():
         truth = model.points @ pose[:3, :3].T + pose[:3, 3]
         assert vgn.target_points_between_pads(grasp.pose, grasp.width_m, plain.gripper, truth) > 0
         assert np.array_equal(grasp.pose, grasp_for(slot).pose)
+
+
+def test_vgn_in_a_pile_infers_once_on_the_workspace_and_assigns_each_detection_to_the_object_it_holds(
+    monkeypatch,
+):
+    """A clutter request (it carries the mode's workspace): VGN's one fixed volume centred on the
+    workspace, one fusion and forward pass for every target of the scene, each detection given to the
+    object whose points it holds; every target's grasp is one of the scene's candidates assigned to it,
+    and the same computed afresh."""
+    from graspexp.planning import NoFeasibleGrasp
+    from graspexp.sim.perceive import slot_id
+
+    plain, table_z, objects, view = _three_in_a_row(-0.08, 0.03)
+    half = np.asarray(plain.mode.workspace_half_size_m, dtype=float)
+    workspace = np.stack([-half, half])
+    calls = []
+    infer = vgn.infer
+    monkeypatch.setattr(vgn, "infer", lambda *a, **k: calls.append(1) or infer(*a, **k))
+
+    def plan_for(slot):
+        obs = dataclasses.replace(view.observation, target_id=slot_id(slot))
+        req = dataclasses.replace(_request(obs, 7 + slot), table_z=table_z, workspace_xy=workspace)
+        try:
+            return vgn.plan_vgn(req)
+        except NoFeasibleGrasp:
+            return None
+
+    monkeypatch.setattr(vgn, "_SCENE", None)
+    results = {slot: plan_for(slot) for slot in objects}
+    assert len(calls) == 1  # one forward pass for the three targets
+    scene, cached = vgn._scene_cached(
+        dataclasses.replace(_request(view.observation), table_z=table_z, workspace_xy=workspace)
+    )
+    assert cached and len(calls) == 1
+    np.testing.assert_array_equal(scene.volume, vgn.world_from_scene_volume(workspace, table_z))
+    np.testing.assert_allclose(scene.volume[:3, 3], [-0.15, -0.15, table_z - vgn.TABLE_IN_VOLUME_M])
+    assert set(np.unique(scene.owner)) <= {0, *(slot_id(s) for s in objects)}
+    found = {slot: r for slot, r in results.items() if r is not None}
+    assert found, "no object of the pile got a grasp"
+    for slot, result in found.items():
+        g = result.grasp
+        mine = [
+            i for i in np.flatnonzero(scene.owner == slot_id(slot)) if np.array_equal(scene.poses[i], g.pose)
+        ]
+        assert len(mine) == 1 and g.n_feasible == int((scene.owner == slot_id(slot)).sum())
+        model, pose = objects[slot]
+        truth = model.points @ pose[:3, :3].T + pose[:3, 3]
+        assert vgn.target_points_between_pads(g.pose, g.width_m, plain.gripper, truth) > 0
+        assert g.extras["infer_cpu_s"] >= 0 and g.extras["n_detected"] == len(scene.found.quality)
+    for (
+        slot
+    ) in objects:  # no detection holds an object other than the one it is assigned to, with more points
+        if results[slot] is None:
+            assert not (scene.owner == slot_id(slot)).any()
+    monkeypatch.setattr(vgn, "_SCENE", None)
+    for slot, result in found.items():
+        np.testing.assert_array_equal(plan_for(slot).grasp.pose, result.grasp.pose)
+    assert len(calls) == 2  # computed afresh once more: the same grasps

@@ -205,3 +205,17 @@ def test_objects_of_a_round_sleep_only_with_a_sleep_threshold(threshold):
     for _ in range(int(1.5 / plain.sim.timestep_s)):
         ts.scene.step()
     assert body.is_sleeping == (threshold > 0)
+
+
+def test_a_clutter_jobs_objective_is_its_gsr_and_zero_when_no_grasp_was_attempted():
+    """The objective of a clutter job (what a sweep or a study reads) is its GSR over the executed
+    attempts; rounds whose planner found no grasp are a result (GSR 0), not a failed job."""
+    from types import SimpleNamespace
+
+    from graspexp.run.round_loop import round_objective
+
+    def rnd(*attempts):
+        return SimpleNamespace(attempts=[{"executed": e, "success": s} for e, s in attempts])
+
+    assert round_objective([rnd((True, True), (True, False)), rnd((False, False))]) == 0.5
+    assert round_objective([rnd((False, False)), rnd()]) == 0.0

@@ -216,6 +216,22 @@ def test_the_camera_and_learned_pages_fingerprint_jobs_compose(name):
     assert "vgn" in planners and (name == "learned" or {"optimal", "antipodal_view"} <= planners)
 
 
+def test_the_camera_clutter_pages_fingerprint_is_one_round_per_planner_and_scene_with_the_camera():
+    """The camera clutter page's fingerprint: one round of each of its planners in pile and packed, every
+    pose registered from the camera, vgn on the Panda it was trained for."""
+    from graspexp.config.compose import compose_config
+
+    page = next(p for p in PAGES if p.name == "clutter_camera")
+    jobs = [compose_config(list(job)) for job in fingerprint_jobs(page)]
+    runs = {(cfg.planner.name, cfg.mode.name) for cfg in jobs}
+    planners = {"optimal", "optimal_plus", "antipodal_view", "vgn"}
+    assert len(jobs) == 8 and runs == {(p, m) for p in planners for m in ("pile", "packed")}
+    for cfg in jobs:
+        assert int(cfg.trials) == 1 and cfg.record is False and cfg.dataset.name == "ycb"
+        assert cfg.perception.source == "depth" and cfg.perception.noise.trans_mm == 10
+        assert (cfg.gripper.name == "panda") == (cfg.planner.name == "vgn")
+
+
 def test_a_page_whose_planner_cannot_run_here_is_skipped_with_one_line(monkeypatch, capsys):
     """Without the optional extra (planner=vgn unavailable) the camera and learned pages are skipped by
     ``results`` and ``results --check`` with one line naming the install command."""
@@ -224,9 +240,9 @@ def test_a_page_whose_planner_cannot_run_here_is_skipped_with_one_line(monkeypat
 
     monkeypatch.setattr(vgn, "find_spec", lambda module: None)  # neither torch nor open3d installed
     kept = available(PAGES)
-    assert {p.name for p in PAGES} - {p.name for p in kept} == {"camera", "learned"}
+    assert {p.name for p in PAGES} - {p.name for p in kept} == {"camera", "learned", "clutter_camera"}
     err = capsys.readouterr().err.splitlines()
-    assert len(err) == 2 and all(
+    assert len(err) == 3 and all(
         f"cannot run here: it needs torch and open3d, the optional extra 'learned': {vgn.INSTALL}" in line
         for line in err
     )
