@@ -20,7 +20,7 @@ import numpy as np
 from graspexp.config import JobConfig
 from graspexp.core.bodies import clutter_body
 from graspexp.core.clutter import AttemptResult, RoundEnd, RoundResult
-from graspexp.core.geometry import transform_points
+from graspexp.core.geometry import matrix_to_quat_wxyz, transform_points
 from graspexp.core.outcome import FailureReason, TrialResult
 from graspexp.core.seeding import derive_seed, rng_for
 from graspexp.datasets.model import ObjectModel
@@ -34,7 +34,7 @@ from graspexp.sim.clutter_scene import (
     pile_drop_pose,
 )
 from graspexp.sim.contacts import gripper_touches
-from graspexp.sim.perceive import perceive_scene, slot_id
+from graspexp.sim.perceive import ScenePerceived, perceive_scene, slot_id
 from graspexp.sim.shape import CollisionShape
 from graspexp.sim.trial import (
     LogSink,
@@ -359,10 +359,12 @@ def _plan_scene(
     )  # fmt: skip
     _pose_errors(row, view.errors.get(first))
     if not plans:
+        _log_camera(ctx, sim, view, order[0], first)
         sim.phase("plan", {"attempt": attempt, "found": False, "n_planned": n})
         return row, None
     *_, name, grasp = min(plans, key=lambda p: p[:3])  # a grasp clear of the neighbours first, then cost
     slot = seen[name][0]
+    _log_camera(ctx, sim, view, name, slot)
     row.target, row.slot, row.executed, row.reason = ctx.objects[slot].model.name, slot, True, None
     row.grasp_cost, row.grasp_width_m, row.n_feasible = grasp.cost, grasp.width_m, grasp.n_feasible
     _pose_errors(row, view.errors.get(slot))
@@ -370,6 +372,22 @@ def _plan_scene(
                        "pick_order": cfg.mode.pick_order, "plan_s": wall})  # fmt: skip
     ctx.recorder.grasp(sim.log_t, {**_grasp_record(grasp), "target": name})
     return row, grasp
+
+
+def _log_camera(ctx: RoundContext, sim: _RoundSim, view: ScenePerceived, name: str, slot: int) -> None:
+    """What the camera saw before the attempt, into the round log as a trial logs it: the views' frames
+    on /tf, depth and id images, the observed cloud, and on /perception the poses of the attempt's target
+    ``name`` (the object of ``slot``; the first planned when none was found): true, prior, registered."""
+    obs = view.observation
+    if obs is None or not sim.recording:
+        return
+    poses = {"object_true": sim.ts.pose_of(name), "object_prior": view.priors[slot]}
+    info: dict = {"source": ctx.cfg.perception.source}
+    if slot in view.errors:
+        info.update(view.errors[slot], estimated_pose=view.poses[slot])
+    frames = {v.name: v.world_from_camera for v in obs.views}
+    sim.rec.transforms(sim.log_t, {k: (T[:3, 3], matrix_to_quat_wxyz(T[:3, :3])) for k, T in frames.items()})
+    ctx.recorder.perception(sim.log_t, dataclasses.replace(obs, target_id=slot_id(slot)), poses, info)
 
 
 def _pose_errors(row: AttemptResult, errors: dict[str, float] | None) -> None:

@@ -113,13 +113,16 @@ def slot_id(slot: int) -> int:
 class ScenePerceived:
     """The planner's view of a clutter scene before one attempt.
 
-    poses : slot -> (4, 4) world pose the planner is given for that object. observation : what the camera
-    saw of the whole scene (every object, id :func:`slot_id`), ``target_id`` unset (0): each plan request
-    gets a copy naming its target; None without a camera. errors : slot -> pose errors of the registered
-    pose (``trans_mm``, ``rot_deg``, ``adds_mm``, ``fitness``); empty unless ``perception.source=depth``.
+    poses : slot -> (4, 4) world pose the planner is given for that object. priors : slot -> (4, 4) the
+    noisy true pose (the registration's start; ``poses`` itself without ``perception.source=depth``).
+    observation : what the camera saw of the whole scene (every object, id :func:`slot_id`), ``target_id``
+    unset (0): each plan request gets a copy naming its target; None without a camera. errors : slot ->
+    pose errors of the registered pose (``trans_mm``, ``rot_deg``, ``adds_mm``, ``fitness``); empty
+    unless ``perception.source=depth``.
     """
 
     poses: dict[int, np.ndarray]
+    priors: dict[int, np.ndarray]
     observation: Observation | None = None
     errors: dict[int, dict[str, float]] = field(default_factory=dict)
 
@@ -141,7 +144,7 @@ def perceive_scene(
         for slot, (_, true) in objects.items()
     }
     if not wants_camera(cfg):
-        return ScenePerceived(priors)
+        return ScenePerceived(priors, priors)
     from graspexp.perception.observe import estimate_pose, observe
     from graspexp.perception.registration import pose_errors
 
@@ -149,7 +152,7 @@ def perceive_scene(
     boxes = support_boxes(table_z, tuple(cfg.mode.support_half_size_m))
     obs = observe(cfg.perception, meshes, boxes, table_z, 0, rng=rng_for(seed, "camera"))
     if cfg.perception.source != "depth":
-        return ScenePerceived(priors, obs)
+        return ScenePerceived(priors, priors, obs)
     poses, errors = {}, {}
     for slot, (model, true) in objects.items():
         start = None if cfg.perception.registration.prior == "none" else priors[slot]
@@ -163,4 +166,4 @@ def perceive_scene(
         )
         poses[slot] = reg.pose
         errors[slot] = {**pose_errors(reg.pose, true, model.points), "fitness": reg.fitness}
-    return ScenePerceived(poses, obs, errors)
+    return ScenePerceived(poses, priors, obs, errors)

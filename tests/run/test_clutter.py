@@ -156,6 +156,38 @@ def test_a_three_object_pile_round_runs_end_to_end_resimulates_and_resumes(tmp_p
 
 
 @pytest.mark.slow
+def test_a_logged_depth_round_records_what_the_camera_saw_and_resimulates(tmp_path):
+    """perception.source=depth with logs: before every attempt the round log gets the camera's frames,
+    cloud and the target's true, prior and registered poses (as a trial's log does); resim agrees."""
+    from helpers.logs import strictly_valid
+
+    from graspexp.record import read_trial
+    from graspexp.record import schemas as S
+    from graspexp.run.resim import resimulate
+    from graspexp.run.runner import run_in_dir
+
+    cfg = compose_cfg(
+        "mode=pile", "dataset=primitives", "objects=[can,box]", "mode.objects_per_round=2", "trials=1",
+        "progress=false", "perception.source=depth", "perception.noise.trans_mm=10", "perception.noise.rot_deg=10",
+    )  # fmt: skip
+    run_in_dir(cfg, tmp_path)
+    path = tmp_path / "trials" / "pile" / "000.mcap"
+    log = read_trial(path)
+    with open(path, "rb") as f:
+        counts = strictly_valid(f)
+    plans = [name for _, name, _ in log.phases if name == "plan"]
+    assert counts[S.TOPIC_PERCEPTION] == len(plans) == counts[S.TOPIC_CLOUD] > 0
+    assert (
+        counts[S.TOPIC_DEPTH] == counts[S.TOPIC_IDS] == len(plans) * len(cfg.perception.camera.azimuths_deg)
+    )
+    last = log.perception
+    assert last["source"] == "depth" and "estimated_pose" in last and last["n_target_points"] > 0
+    assert np.linalg.norm(last["estimated_pose"][:3, 3] - last["true_pose"][:3, 3]) < 0.015
+    agrees, why = resimulate(log)  # the heap, the camera and every registration again, from the seed
+    assert agrees, why
+
+
+@pytest.mark.slow
 def test_a_depth_pile_round_plans_on_registered_poses_and_records_their_errors():
     """perception.source=depth in a 3-object pile: each plan request carries the camera's observation of
     the whole scene (every object's id, its own target's), and each attempt records its target's errors."""
