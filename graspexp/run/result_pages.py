@@ -14,7 +14,12 @@ from collections.abc import Callable, Sequence
 
 from graspexp.report.build import agreement_section, build_report
 from graspexp.report.camera import COLUMNS, LEARNED_COLUMNS, camera_markdown
-from graspexp.report.clutter import clutter_markdown, find_rounds, registration_markdown
+from graspexp.report.clutter import (
+    clutter_markdown,
+    find_rounds,
+    registration_markdown,
+    side_by_side_markdown,
+)
 from graspexp.report.collect import collect
 from graspexp.report.gallery import write_gallery
 from graspexp.report.learned import learned_markdown
@@ -357,9 +362,10 @@ CLUTTER_CAMERA_FINGERPRINT = tuple(
 """One round of each planner in each scene (:data:`CLUTTER_SETTINGS`), poses registered from the camera."""
 
 
-def _clutter_camera(runs: dict[str, Sweep]) -> Callable[[PageInput], str]:
+def _clutter_camera(runs: dict[str, Sweep], exact: Sweep) -> Callable[[PageInput], str]:
     """The clutter table and the registered poses' errors of the camera clutter page, each sweep's rows
-    named by its label (:data:`CLUTTER_CAMERA_RUNS`)."""
+    named by its label (:data:`CLUTTER_CAMERA_RUNS`), and the planners that also ran with exact poses
+    (``exact``: the exact-pose page's rounds) side by side."""
 
     def render(page: PageInput) -> str:
         rounds = [
@@ -370,6 +376,13 @@ def _clutter_camera(runs: dict[str, Sweep]) -> Callable[[PageInput], str]:
         return "\n".join(
             [
                 clutter_markdown(rounds),
+                "",
+                "### Exact and registered poses side by side",
+                "",
+                "The exact-pose rounds are the [exact-pose page](clutter.md)'s (same protocol and pool; round "
+                "r draws the same objects in both).",
+                "",
+                side_by_side_markdown(find_rounds(page.runs[exact]), rounds),
                 "",
                 "### Registered poses of the grasped objects",
                 "",
@@ -452,8 +465,8 @@ PAGES: tuple[Page, ...] = (
     Page(
         "clutter_camera",
         "docs/results/clutter_camera.md",
-        tuple(CLUTTER_CAMERA_RUNS.values()),
-        _clutter_camera(CLUTTER_CAMERA_RUNS),
+        (*CLUTTER_CAMERA_RUNS.values(), CLUTTER),
+        _clutter_camera(CLUTTER_CAMERA_RUNS, CLUTTER),
         CLUTTER_CAMERA_FINGERPRINT,
         ("dataset=ycb", "trials=1"),
         CLUTTER_SETTINGS,
