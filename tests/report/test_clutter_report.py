@@ -1,6 +1,8 @@
 """The clutter table (``report`` on a ``mode=pile``/``packed`` run): GSR over executed attempts, DR over the
 objects placed, both with Wilson intervals, the rounds' ends, the failure reasons and the planning latency."""
 
+import dataclasses
+
 import pytest
 
 from graspexp.core.clutter import AttemptResult, RoundResult
@@ -76,3 +78,17 @@ def test_every_failed_attempt_of_a_logged_round_gets_a_picture_strip(tmp_path):
     report = write_report(build_report(tmp_path / "run", progress=False), tmp_path / "report")
     assert "[clutter_failures.md](clutter_failures.md)" in report
     assert write_clutter_strips(tmp_path / "empty", tmp_path / "none") == ""  # no round log: nothing drawn
+
+
+def test_exact_and_registered_rounds_side_by_side_for_the_planners_both_ran():
+    from graspexp.report.clutter import side_by_side_markdown
+
+    exact = _rounds()
+    registered = [dataclasses.replace(r, attempts=r.attempts[:1]) for r in _rounds()]  # fewer attempts
+    other = [dataclasses.replace(r, planner="antipodal") for r in _rounds()]  # only with exact poses
+    text = side_by_side_markdown(exact + other, registered)
+    rows = [line for line in text.splitlines() if line.startswith("| optimal ")]
+    assert len(rows) == 1 and "| 2 / 2 |" in rows[0] and "antipodal" not in text
+    gsr_exact = wilson_interval(4, 5)  # 4 of the 5 executed attempts held
+    assert f"{100 * 4 / 5:.1f} [{100 * gsr_exact[0]:.1f}, {100 * gsr_exact[1]:.1f}]" in rows[0]
+    assert side_by_side_markdown(exact, other).startswith("no planner and scene")
