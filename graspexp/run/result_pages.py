@@ -379,8 +379,8 @@ def _clutter_camera(runs: dict[str, Sweep], exact: Sweep) -> Callable[[PageInput
                 "",
                 "### Exact and registered poses side by side",
                 "",
-                "The exact-pose rounds are the [exact-pose page](clutter.md)'s (same protocol and pool; round "
-                "r draws the same objects in both).",
+                "The exact-pose rounds are the [exact-pose page](clutter.md)'s, taken over the rounds that "
+                "ran here (round r draws and places the same objects in both: the same heaps).",
                 "",
                 side_by_side_markdown(find_rounds(page.runs[exact]), rounds),
                 "",
