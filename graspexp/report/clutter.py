@@ -11,13 +11,9 @@ import pandas as pd
 
 from graspexp.config.mode import CLUTTER_MODES
 from graspexp.core.clutter import RoundEnd, RoundResult
-from graspexp.core.run_layout import TRIALS_DIR
+from graspexp.core.run_layout import ATTEMPTS_CSV, ROUNDS_CSV, TRIALS_DIR
 from graspexp.record import CorruptLogError, iter_trial_logs, read_round
 from graspexp.report.stats import percentiles, success_pct
-
-ROUNDS_CSV = "rounds.csv"
-ATTEMPTS_CSV = "attempts.csv"
-"""A clutter run's tables beside its logs: one row per round, one per attempt."""
 
 
 def rounds_frame(rounds: Iterable[RoundResult]) -> pd.DataFrame:

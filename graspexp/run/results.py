@@ -41,8 +41,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from graspexp.core.run_layout import results_csv
-from graspexp.report.clutter import ATTEMPTS_CSV
+from graspexp.core.run_layout import ATTEMPTS_CSV, results_csv
 from graspexp.report.pages import (
     Provenance,
     duration,

@@ -14,6 +14,8 @@ from tqdm import tqdm
 from graspexp.core.clutter import RoundEnd, RoundResult
 from graspexp.core.files import write_atomic
 from graspexp.core.run_layout import (
+    ATTEMPTS_CSV,
+    ROUNDS_CSV,
     LinkedRunPathError,
     check_not_linked,
     real_folder,
@@ -27,8 +29,6 @@ from graspexp.record import CorruptLogError, read_round, trial_recorder
 from graspexp.record.scene import round_bodies, round_scene
 from graspexp.record.writer import is_write_error
 from graspexp.report.clutter import (
-    ATTEMPTS_CSV,
-    ROUNDS_CSV,
     attempts_frame,
     clutter_markdown,
     read_rounds,
