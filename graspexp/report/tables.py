@@ -87,9 +87,10 @@ def success_table(df: pd.DataFrame, dataset: str, planner: str) -> SuccessTable:
     """The success table of one dataset and planner from the collected results ``df``.
 
     Rows: the paper's objects in the paper's order (those without logs get n = 0, shown as n/a), then
-    objects we ran that the paper does not list, then Average (mean over the paper's objects we ran,
-    with a Wilson interval over their pooled trials; paper = the Average as printed) and the paper's
-    average over the same objects we ran.
+    objects we ran that the paper does not list, then Average (mean over the paper's objects we ran, or
+    over every object we ran when none of the paper's did, e.g. a held-out split; with a Wilson interval
+    over their pooled trials; paper = the Average as printed) and the paper's average over the same
+    objects we ran.
     """
     sel = df[(df["dataset"] == dataset) & (df["planner"] == planner)]
     paper = PAPER_TABLES.get(dataset)
@@ -98,7 +99,7 @@ def success_table(df: pd.DataFrame, dataset: str, planner: str) -> SuccessTable:
     extra = [o for o in ran if o not in paper_objects]
     objects = paper_objects + extra
     labels = {o: (paper.labels[o] if paper and o in paper.labels else o) for o in objects}
-    in_avg = paper_objects if paper else objects
+    in_avg = paper_objects if set(paper_objects) & set(ran) else objects  # held-out objects: their own mean
     records = []
     for si, (mode, rot) in enumerate(_settings_for(sel)):
         in_setting = sel[(sel["mode"] == mode) & (sel["rot"] == rot)]

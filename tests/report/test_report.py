@@ -495,3 +495,29 @@ def test_an_object_that_never_ran_is_na_in_the_paper_table_not_zero(tmp_path: Pa
     assert ape["n"] == 0 and np.isnan(ape["ours_pct"]) and avg["ours_pct"] == 100.0
     text = write_report(report, tmp_path / "out", gallery_per_reason=0)
     assert "## Not run (2 trials)" in text and "linemod/optimal/collab/z 'ape': 2 trial(s) not run" in text
+
+
+def test_held_out_objects_of_a_paper_dataset_average_over_themselves() -> None:
+    """A run of YCB objects the paper does not list (``dataset.split=test``): the Average is over the
+    objects run, beside the paper's printed Average for scale; with a paper object among them, over the
+    paper's objects only (the paper's own Average)."""
+    from graspexp.report.tables import AVERAGE, success_table
+
+    def rows(objects):
+        return pd.DataFrame(
+            [{"dataset": "ycb", "planner": "optimal_plus", "object": o, "mode": "collab", "rot": "z",
+              "success": s, "reason": None if s else "dropped"}
+             for o, outcomes in objects.items() for s in outcomes]
+        )  # fmt: skip
+
+    held_out = {"003_cracker_box": [True, True], "024_bowl": [True, False]}
+
+    def average(objects):
+        cells = success_table(rows(objects), "ycb", "optimal_plus").cells
+        return cells[cells["label"] == AVERAGE].iloc[0]
+
+    avg = average(held_out)
+    assert avg["n"] == 4 and avg["ours_pct"] == pytest.approx(75.0) and np.isfinite(avg["paper_pct"])
+    mixed = {**held_out, "025_mug": [True, False]}
+    avg = average(mixed)
+    assert avg["n"] == 2 and avg["ours_pct"] == pytest.approx(50.0)  # the paper's objects only
