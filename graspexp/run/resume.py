@@ -9,7 +9,9 @@ deleted) and redone."""
 import datetime
 import logging
 import os
+from collections.abc import Callable
 from pathlib import Path
+from typing import TypeVar
 
 from omegaconf import DictConfig
 
@@ -33,6 +35,7 @@ from graspexp.run.locks import DirectoryLock, RunError
 from graspexp.run.objects import LoadedObject
 
 log = logging.getLogger(__name__)
+T = TypeVar("T")
 
 
 def job_lock(run_dir: Path) -> DirectoryLock:
@@ -132,26 +135,40 @@ def _facts(meta: dict[str, str]) -> str:
     return f", {meta['mesh_faces']} faces, area {float(meta['mesh_area_m2']):.4g} m^2{volume}"
 
 
+def finished_log(
+    path: Path, run_dir: Path, what: str, read: Callable[[Path], T], redo: Callable[[T], str]
+) -> T | None:
+    """The result ``read(path)`` of a complete log at ``path``; None if absent. A log that cannot be read
+    (:class:`CorruptLogError`, ``ValueError``), or whose result ``redo`` gives a reason to run again (a
+    non-empty string), is moved aside (:func:`quarantine`) and its ``what`` ("trial", "round") is redone."""
+    if not path.exists():
+        return None
+    try:
+        result = read(path)
+        why = redo(result)
+    except (CorruptLogError, ValueError) as exc:
+        why = str(exc)
+    if why:
+        quarantine(path, run_dir, f"re-running {what}: {why}")
+        return None
+    return result
+
+
 def finished_result(path: Path, run_dir: Path, object_name: str, trial: int) -> TrialResult | None:
     """The result of a complete log at ``path``; None if absent. A log whose /result is unreadable or not
     a valid result of this trial, and a trial that ended in ``error``, are moved aside
     (:func:`quarantine`) and redone."""
-    if not path.exists():
-        return None
-    try:
-        result = result_from_dict(read_result(path))
+
+    def redo(result: TrialResult) -> str:
         if (result.object, result.trial) != (object_name, trial):
-            raise ValueError(f"its result is of {result.object} trial {result.trial}")
-    except (CorruptLogError, ValueError) as exc:
-        quarantine(path, run_dir, f"re-running trial: {exc}")
-        return None
-    if result.reason == FailureReason.ERROR.value:
-        quarantine(path, run_dir, f"re-running trial: it ended in an error ({result.error})")
-        return None
-    if not result.at_rest and result.reason != FailureReason.NOT_AT_REST.value:
-        quarantine(path, run_dir, "re-running trial: it planned on a moving object (before not_at_rest)")
-        return None
-    return result
+            return f"its result is of {result.object} trial {result.trial}"
+        if result.reason == FailureReason.ERROR.value:
+            return f"it ended in an error ({result.error})"
+        if not result.at_rest and result.reason != FailureReason.NOT_AT_REST.value:
+            return "it planned on a moving object (before not_at_rest)"
+        return ""
+
+    return finished_log(path, run_dir, "trial", lambda p: result_from_dict(read_result(p)), redo)
 
 
 def quarantine(path: Path, run_dir: Path, why: str) -> Path:

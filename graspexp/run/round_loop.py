@@ -25,7 +25,7 @@ from graspexp.core.run_layout import (
 from graspexp.core.seeding import rng_for, round_seed
 from graspexp.planning import plan
 from graspexp.quality import fc_min_mu
-from graspexp.record import CorruptLogError, read_round, trial_recorder
+from graspexp.record import read_round, trial_recorder
 from graspexp.record.scene import round_bodies, round_scene
 from graspexp.record.writer import is_write_error
 from graspexp.report.clutter import (
@@ -37,7 +37,7 @@ from graspexp.report.clutter import (
 from graspexp.run.locks import RunError
 from graspexp.run.objects import LoadedObject
 from graspexp.run.provenance import job_metadata
-from graspexp.run.resume import quarantine
+from graspexp.run.resume import finished_log
 from graspexp.sim.clutter import RoundContext, RoundObject, run_round
 from graspexp.sim.trial import plain_config
 
@@ -124,19 +124,15 @@ def error_round(cfg: DictConfig, r: int, seed: int, drawn: list[str], exc: BaseE
 def finished_round(path: Path, run_dir: Path, r: int) -> RoundResult | None:
     """The result of round ``r``'s complete log at ``path``; None if absent. A log whose /round is unreadable or
     of another round, and a round that ended in ``error``, are moved aside and the round is redone."""
-    if not path.exists():
-        return None
-    try:
-        result = RoundResult.from_dict(read_round(path))
+
+    def redo(result: RoundResult) -> str:
         if result.round != r:
-            raise ValueError(f"its result is of round {result.round}")
-    except (CorruptLogError, ValueError) as exc:
-        quarantine(path, run_dir, f"re-running round: {exc}")
-        return None
-    if result.end == RoundEnd.ERROR.value:
-        quarantine(path, run_dir, f"re-running round: it ended in an error ({result.error})")
-        return None
-    return result
+            return f"its result is of round {result.round}"
+        if result.end == RoundEnd.ERROR.value:
+            return f"it ended in an error ({result.error})"
+        return ""
+
+    return finished_log(path, run_dir, "round", lambda p: RoundResult.from_dict(read_round(p)), redo)
 
 
 def write_round_summary(run_dir: Path, results: list[RoundResult]) -> str:
