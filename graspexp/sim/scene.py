@@ -145,7 +145,7 @@ def add_object(
     )
     obj_mat = sapien.physx.PhysxMaterial(static, dynamic, 0.0)
     body = sapien.physx.PhysxRigidDynamicComponent()
-    for part in _object_shapes(shape, obj_mat):
+    for part in object_shapes(shape, obj_mat):
         part.set_density(1000.0)
         body.attach(part)
     if len(body.get_collision_shapes()) != len(shape.parts):
@@ -164,10 +164,12 @@ def add_object(
     return entity, body
 
 
-def _object_shapes(
+def object_shapes(
     shape: CollisionShape, material: sapien.physx.PhysxMaterial
 ) -> list[sapien.physx.PhysxCollisionShape]:
-    """PhysX shapes of the object's collision parts (object frame, metres)."""
+    """PhysX shapes of the object's collision parts (object frame, metres). A mesh read from its file is
+    cooked on the first call of a process (about 15-20 ms for a 2,000-vertex YCB mesh with its SDF) and
+    reused by the later ones."""
     one = np.ones(3, dtype=np.float32)
     if shape.convex:
         return [
