@@ -145,7 +145,7 @@ def add_object(
     )
     obj_mat = sapien.physx.PhysxMaterial(static, dynamic, 0.0)
     body = sapien.physx.PhysxRigidDynamicComponent()
-    for part in object_shapes(shape, obj_mat):
+    for part in _object_shapes(shape, obj_mat):
         part.set_density(1000.0)
         body.attach(part)
     if len(body.get_collision_shapes()) != len(shape.parts):
@@ -164,12 +164,18 @@ def add_object(
     return entity, body
 
 
-def object_shapes(
+def cook_shape(shape: CollisionShape, sim: SimConfig) -> None:
+    """Cook the object's PhysX shapes as :func:`add_object` will (after :func:`configure_physx`): a mesh read
+    from its file is cooked with its SDF once per process and SDF setting (about 15-20 ms for a
+    2,000-vertex YCB mesh) and reused by the later scenes."""
+    configure_physx(sim)
+    _object_shapes(shape, sapien.physx.PhysxMaterial(0.5, 0.5, 0.0))
+
+
+def _object_shapes(
     shape: CollisionShape, material: sapien.physx.PhysxMaterial
 ) -> list[sapien.physx.PhysxCollisionShape]:
-    """PhysX shapes of the object's collision parts (object frame, metres). A mesh read from its file is
-    cooked on the first call of a process (about 15-20 ms for a 2,000-vertex YCB mesh with its SDF) and
-    reused by the later ones."""
+    """PhysX shapes of the object's collision parts (object frame, metres)."""
     one = np.ones(3, dtype=np.float32)
     if shape.convex:
         return [

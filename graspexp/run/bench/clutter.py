@@ -9,7 +9,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-import sapien
 
 from graspexp.config.compose import compose_config
 from graspexp.core.seeding import round_seed
@@ -23,7 +22,7 @@ from graspexp.run.job_config import make_ready
 from graspexp.run.objects import load_object, trial_context
 from graspexp.run.round_loop import draw_objects
 from graspexp.sim.clutter import RoundContext, RoundObject, run_round
-from graspexp.sim.scene import object_shapes
+from graspexp.sim.scene import cook_shape
 from graspexp.sim.trial import plain_config, run_trial
 
 LATENCY_PLANNERS = ("optimal", "optimal_plus")
@@ -47,9 +46,8 @@ def clutter_rounds(overrides: list[str], rounds: int, out: Path) -> tuple[list[d
     cfg, plain = _job(overrides)
     pool = select_objects(cfg.dataset, cfg.objects)
     cache = {n: load_object(cfg, n, plain) for n in pool}
-    material = sapien.physx.PhysxMaterial(0.5, 0.5, 0.0)
     for obj in cache.values():
-        object_shapes(obj.hulls, material)
+        cook_shape(obj.hulls, plain.sim)
     rows, scenes, drawn_all = [], [], []
     for r in range(rounds):
         seed = round_seed(plain, r)
