@@ -316,14 +316,10 @@ class _TryTable:
             self.padded[at] = True
         return collides, ok
 
-    def prepare(self, paths: np.ndarray, neighbours: bool) -> None:
-        """Place the paths ``paths`` not placed yet and test their tries (:meth:`batch`) in one pass."""
-        self.place(paths)
-        self._ok(paths, neighbours)
-
     def batch(self, paths: np.ndarray, neighbours: bool) -> _Batch:
-        """The tries of the placed paths ``paths`` as a :class:`_Batch`, among the neighbours (their hits
-        are collisions) or not."""
+        """The tries of the paths ``paths`` as a :class:`_Batch`, among the neighbours (their hits are
+        collisions) or not: those not placed yet placed, and those not tested yet tested, in one pass."""
+        self.place(paths)
         collides, ok = self._ok(paths, neighbours)
         ks, ps = np.unravel_index(paths, self.cand.costs.shape)
         flat = ok.reshape(-1)
@@ -363,7 +359,6 @@ class _Tries:
             start = i * PATH_BATCH
             size = min(max(start, PATH_BATCH), MAX_CHUNK)
             paths = self.order[start : start + size]
-            self.table.prepare(paths, self.neighbours)
             self.chunks[i] = (
                 min(i + size // PATH_BATCH, self.n_batches),
                 self.table.batch(paths, self.neighbours),
