@@ -368,13 +368,13 @@ def _choose_path(
         ks, ps = np.unravel_index(chunk, (k, m))
         rots = grasp_rotations(directions[ks, ps], cand.pose_axis)
         passing = _test_batch(req, cand, openings, scratch, ks, ps, rots)
-        for j in range(b, end):
-            rows = slice(bounds[j] - bounds[b], bounds[j + 1] - bounds[b])
-            tests.keep(scratch, ks[rows], ps[rows])
-            fit = np.flatnonzero(passing[rows])
-            if len(fit):
-                i = rows.start + fit[0]
-                return (int(ks[i]), int(ps[i])), rots[i], need
+        fit = np.flatnonzero(passing)
+        if len(fit):  # kept up to the end of the batch of the first passing path
+            i = int(fit[0])
+            upto = bounds[np.searchsorted(bounds, bounds[b] + i, "right")] - bounds[b]
+            tests.keep(scratch, ks[:upto], ps[:upto])
+            return (int(ks[i]), int(ps[i])), rots[i], need
+        tests.keep(scratch, ks, ps)
         b = end
     # Every path above the support was examined and none passed. Fallbacks: a section that fits the
     # stroke (opened to the section), then, in pl.fallback_modes, the largest in-area share reached.
@@ -448,11 +448,17 @@ def _test_batch(
         )
         if req.support_blocks_gripper:
             free &= lowest_z(poses, gr, widths, pl.sphere_radius_m) >= req.table_z
-        if req.neighbours:
+        if req.neighbours:  # only a path clear of the target and the support may be clear of them all
             tests.alone[ks, ps] = free
-            free &= ~neighbour_hits(
-                req.neighbour_cells, poses, gr, widths, sweep_m=pl.sphere_radius_m, margin_m=0.0
-            )
+            if free.any():
+                free[free] = ~neighbour_hits(
+                    req.neighbour_cells,
+                    poses[free],
+                    gr,
+                    widths[free],
+                    sweep_m=pl.sphere_radius_m,
+                    margin_m=0.0,
+                )
         tests.free[ks, ps] = free
         ok &= free
     return ok

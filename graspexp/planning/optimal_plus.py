@@ -216,14 +216,16 @@ class _Batch:
     """Steps 1-3 of the module doc, all but the area test, for the tries of P paths (a whole number of
     :data:`PATH_BATCH` es, the last maybe short).
 
-    ks, ps : (P,) cluster and path of each path; poses : (P * R * O, 4, 4) and widths_m : (P * R * O,) the
-    tries placed (step 2), path-major, then roll (R), then depth offset (O); too_wide, below_support,
-    collides, placed_ok : (P * R * O,) bool, each try's first failed check of step 2 and whether it passed
+    ks, ps : (P,) cluster and path of each path, paths : (P,) its row in ``poses`` and ``widths_m``, the
+    table's (:class:`_TryTable`) placed tries (step 2), (n, R * O, 4, 4) and (n, R * O), roll (R)-major,
+    then depth offset (O); too_wide, below_support, collides, placed_ok : (P * R * O,) bool, path-major,
+    then roll, then depth offset: each try's first failed check of step 2 and whether it passed
     step 2; held : (P * R * O,) bool, the placed tries passing step 3 but for the area test; depth_m, share
     : (P * R * O,) pad depth, m (-inf where not placed) and in-area share (0 where not placed)."""
 
     ks: np.ndarray
     ps: np.ndarray
+    paths: np.ndarray
     poses: np.ndarray
     widths_m: np.ndarray
     too_wide: np.ndarray
@@ -326,8 +328,9 @@ class _TryTable:
         return _Batch(
             ks=ks,
             ps=ps,
-            poses=self.poses[paths].reshape(-1, 4, 4),
-            widths_m=self.widths[paths].reshape(-1),
+            paths=paths,
+            poses=self.poses,
+            widths_m=self.widths,
             too_wide=self.too_wide[paths].reshape(-1),
             below_support=self.below[paths].reshape(-1),
             collides=(self.check[paths] & collides).reshape(-1),
@@ -412,13 +415,13 @@ def _search_paths(pl, tries: _Tries, min_share: float) -> tuple[list[Candidate],
             r = int(np.argmax(ok[i].any(axis=1)))
             score = np.where(ok[i, r], np.minimum(depth[i, r], pl.pad_depth_target_m), -np.inf)
             j = int(by_offset[int(np.argmax(score[by_offset]))])
-            f = (i * n_roll + r) * n_off + j
+            at = (batch.paths[i], r * n_off + j)
             passed.append(
                 Candidate(
                     cluster=int(batch.ks[i]),
                     path=int(batch.ps[i]),
-                    pose=batch.poses[f],
-                    width_m=float(batch.widths_m[f]),
+                    pose=batch.poses[at].copy(),
+                    width_m=float(batch.widths_m[at]),
                     pad_depth_m=float(depth[i, r, j]),
                     depth_offset_m=float(offsets[j]),
                     roll_deg=float(pl.rolls_deg[r]),
