@@ -347,10 +347,12 @@ def _slab_span(
         y_hi[i] = y if inside else -big
     # A second, scalar pass: LLVM does not vectorise float min/max reductions without function-wide
     # no-NaN attributes, which numba does not set; fused into the first pass they halve its speed.
-    lo, hi = big, -big
-    for i in range(k):
-        lo = y_lo[i] if y_lo[i] < lo else lo
-        hi = y_hi[i] if y_hi[i] > hi else hi
+    lo, hi = _extremes(y_lo, y_hi, k, big)
+    if lo == 0.0 or hi == 0.0:  # which of +0 and -0: the first in point order, as one chain keeps it
+        lo, hi = big, -big
+        for i in range(k):
+            lo = y_lo[i] if y_lo[i] < lo else lo
+            hi = y_hi[i] if y_hi[i] > hi else hi
     if lo <= hi:  # some point was inside
         out[0] = lo
         out[1] = hi
@@ -484,11 +486,39 @@ def _pad_reach(
         xs[i], ys[i], zs[i] = x, y, z
         y_lo[i] = y if inside else np.inf
         y_hi[i] = y if inside else -np.inf
-    lo, hi = np.inf, -np.inf
-    for i in range(k):  # selects, no branches
-        lo = y_lo[i] if y_lo[i] < lo else lo
-        hi = y_hi[i] if y_hi[i] > hi else hi
+    lo, hi = _extremes(y_lo, y_hi, k, np.inf)
+    if lo == 0.0 or hi == 0.0:  # which of +0 and -0: the first in point order, as one chain keeps it
+        lo, hi = np.inf, -np.inf
+        for i in range(k):  # selects, no branches
+            lo = y_lo[i] if y_lo[i] < lo else lo
+            hi = y_hi[i] if y_hi[i] > hi else hi
     return lo, hi
+
+
+@_jit
+def _extremes(y_lo: np.ndarray, y_hi: np.ndarray, k: int, big: float) -> tuple[float, float]:
+    """The smallest of ``y_lo[:k]`` and ``big`` and the largest of ``y_hi[:k]`` and ``-big`` (no NaN), in
+    four independent chains of selects each (one chain waits on every compare: four run at once). The
+    extremes' values are those of one chain; only a zero's sign may differ (+0 and -0 compare equal, and
+    one chain keeps the first in order): the callers redo a zero in one chain."""
+    l0, l1, l2, l3 = big, big, big, big
+    h0, h1, h2, h3 = -big, -big, -big, -big
+    k4 = k - k % 4
+    for i in range(0, k4, 4):
+        l0 = y_lo[i] if y_lo[i] < l0 else l0
+        l1 = y_lo[i + 1] if y_lo[i + 1] < l1 else l1
+        l2 = y_lo[i + 2] if y_lo[i + 2] < l2 else l2
+        l3 = y_lo[i + 3] if y_lo[i + 3] < l3 else l3
+        h0 = y_hi[i] if y_hi[i] > h0 else h0
+        h1 = y_hi[i + 1] if y_hi[i + 1] > h1 else h1
+        h2 = y_hi[i + 2] if y_hi[i + 2] > h2 else h2
+        h3 = y_hi[i + 3] if y_hi[i + 3] > h3 else h3
+    for i in range(k4, k):
+        l0 = y_lo[i] if y_lo[i] < l0 else l0
+        h0 = y_hi[i] if y_hi[i] > h0 else h0
+    l0, l2 = (l1 if l1 < l0 else l0), (l3 if l3 < l2 else l2)
+    h0, h2 = (h1 if h1 > h0 else h0), (h3 if h3 > h2 else h2)
+    return (l2 if l2 < l0 else l0), (h2 if h2 > h0 else h0)
 
 
 @_jit

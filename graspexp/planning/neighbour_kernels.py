@@ -84,26 +84,30 @@ def cube_sort(points: np.ndarray, side: float, slack: float):
     """The (N, 3) cloud ``points`` (m) sorted into cubes of side ``side`` (m) from its lowest corner, by a
     counting sort: (sorted points (N, 3), starts (C + 1,) int64, centres (C, 3), radii (C,)) of the C
     occupied cubes: a cube's points ``sorted[starts[c]:starts[c + 1]]``, the middle of their box and the
-    farthest of them from it plus ``slack``, m (:class:`graspexp.planning.cells.CellCloud`)."""
+    farthest of them from it plus ``slack``, m (:class:`graspexp.planning.cells.CellCloud`). A point's cube
+    is its offset from the corner times ``1 / side``, truncated: one at a cube's face may fall in either
+    cube, and either is right (a cube's sphere bounds the points it holds, whichever they are). Bounds
+    are kept in scalars (registers), and a cube's radius is the root of its largest squared distance
+    (the root is monotonic: the largest root, bit for bit)."""
     n = points.shape[0]
-    lo = np.empty(3)
-    dims = np.ones(3, dtype=np.int64)
-    hi = np.empty(3)
-    for a in range(3):
-        lo[a], hi[a] = points[0, a], points[0, a]
+    x0, y0, z0 = points[0, 0], points[0, 1], points[0, 2]
+    x1, y1, z1 = x0, y0, z0
     for i in range(n):
-        for a in range(3):
-            lo[a], hi[a] = min(lo[a], points[i, a]), max(hi[a], points[i, a])
-    for a in range(3):
-        dims[a] = int(np.floor((hi[a] - lo[a]) / side)) + 1
+        x, y, z = points[i, 0], points[i, 1], points[i, 2]
+        x0, x1 = min(x0, x), max(x1, x)
+        y0, y1 = min(y0, y), max(y1, y)
+        z0, z1 = min(z0, z), max(z1, z)
+    inv = 1.0 / side
+    nx, ny, nz = int((x1 - x0) * inv) + 1, int((y1 - y0) * inv) + 1, int((z1 - z0) * inv) + 1
     cube = np.empty(n, dtype=np.int64)
-    counts = np.zeros(dims[0] * dims[1] * dims[2] + 1, dtype=np.int64)
+    counts = np.zeros(nx * ny * nz + 1, dtype=np.int64)
     for i in range(n):
-        ix = min(int(np.floor((points[i, 0] - lo[0]) / side)), dims[0] - 1)
-        iy = min(int(np.floor((points[i, 1] - lo[1]) / side)), dims[1] - 1)
-        iz = min(int(np.floor((points[i, 2] - lo[2]) / side)), dims[2] - 1)
-        cube[i] = (ix * dims[1] + iy) * dims[2] + iz
-        counts[cube[i] + 1] += 1
+        ix = min(int((points[i, 0] - x0) * inv), nx - 1)
+        iy = min(int((points[i, 1] - y0) * inv), ny - 1)
+        iz = min(int((points[i, 2] - z0) * inv), nz - 1)
+        c = (ix * ny + iy) * nz + iz
+        cube[i] = c
+        counts[c + 1] += 1
     occupied = 0
     for b in range(1, counts.shape[0]):
         occupied += counts[b] > 0
@@ -123,18 +127,19 @@ def cube_sort(points: np.ndarray, side: float, slack: float):
         if e == s:
             continue
         starts[c] = s
-        for a in range(3):
-            lo[a], hi[a] = out[s, a], out[s, a]
+        bx0, by0, bz0 = out[s, 0], out[s, 1], out[s, 2]
+        bx1, by1, bz1 = bx0, by0, bz0
         for i in range(s + 1, e):
-            for a in range(3):
-                lo[a], hi[a] = min(lo[a], out[i, a]), max(hi[a], out[i, a])
-        for a in range(3):
-            centres[c, a] = (lo[a] + hi[a]) / 2
+            bx0, bx1 = min(bx0, out[i, 0]), max(bx1, out[i, 0])
+            by0, by1 = min(by0, out[i, 1]), max(by1, out[i, 1])
+            bz0, bz1 = min(bz0, out[i, 2]), max(bz1, out[i, 2])
+        cx, cy, cz = (bx0 + bx1) / 2, (by0 + by1) / 2, (bz0 + bz1) / 2
         far = 0.0
         for i in range(s, e):
-            d0, d1, d2 = out[i, 0] - centres[c, 0], out[i, 1] - centres[c, 1], out[i, 2] - centres[c, 2]
-            far = max(far, np.sqrt(d0 * d0 + d1 * d1 + d2 * d2))
-        radii[c] = far + slack
+            d0, d1, d2 = out[i, 0] - cx, out[i, 1] - cy, out[i, 2] - cz
+            far = max(far, d0 * d0 + d1 * d1 + d2 * d2)
+        centres[c, 0], centres[c, 1], centres[c, 2] = cx, cy, cz
+        radii[c] = np.sqrt(far) + slack
         c += 1
     starts[occupied] = n
     return out, starts, centres, radii

@@ -59,7 +59,7 @@ from graspexp.core.geometry import transform_points
 from graspexp.core.seeding import rng_for
 from graspexp.grippers import GripperGeometry
 from graspexp.planning.area_rule import area_test, fallback_share, no_grasp_in_area
-from graspexp.planning.collision import Placement, cloud_hits, neighbour_hits, place_for_request
+from graspexp.planning.collision import cloud_hits, neighbour_hits, place_for_request
 from graspexp.planning.details import Candidate, OptimalPlusDetails, Shortlist
 from graspexp.planning.friction import cone_cosine
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
@@ -79,9 +79,11 @@ NAME = "optimal_plus"
 PATH_BATCH = 16
 """Paths examined together, in ascending paper cost: the search stops after the batch in which
 ``shortlist`` paths have passed."""
-MAX_CHUNK = 64
+MAX_CHUNK = 256
 """Most paths whose tries are evaluated in one array pass (:class:`_Tries`), a multiple of
-:data:`PATH_BATCH`."""
+:data:`PATH_BATCH`. The chunks double up to it, so at most half of a search's placements are ahead of its
+end; a search of every path (a clutter round's target that no path clears of its neighbours) makes
+7 passes over about 750 paths, where chunks of 64 made 14, each with a fixed cost of numpy calls."""
 
 
 def _check_params(pl) -> None:
@@ -211,16 +213,25 @@ def pick_shortlisted(choose_by: str, costs: np.ndarray, robust: np.ndarray, exce
 
 @dataclass(frozen=True)
 class _Batch:
-    """Steps 1-3 of the module doc, all but the area test, for the tries of :data:`PATH_BATCH` paths.
+    """Steps 1-3 of the module doc, all but the area test, for the tries of P paths (a whole number of
+    :data:`PATH_BATCH` es, the last maybe short).
 
-    ks, ps : (B,) cluster and path of each path; placed : the (B * R * O) tries placed (step 2), path-major,
-    then roll (R), then depth offset (O); held : (B * R * O,) bool, the placed tries passing step 3 but
-    for the area test; depth_m, share : (B * R * O,) pad depth, m (-inf where not placed) and in-area share
-    (0 where not placed)."""
+    ks, ps : (P,) cluster and path of each path, paths : (P,) its row in ``poses`` and ``widths_m``, the
+    table's (:class:`_TryTable`) placed tries (step 2), (n, R * O, 4, 4) and (n, R * O), roll (R)-major,
+    then depth offset (O); too_wide, below_support, collides, placed_ok : (P * R * O,) bool, path-major,
+    then roll, then depth offset: each try's first failed check of step 2 and whether it passed
+    step 2; held : (P * R * O,) bool, the placed tries passing step 3 but for the area test; depth_m, share
+    : (P * R * O,) pad depth, m (-inf where not placed) and in-area share (0 where not placed)."""
 
     ks: np.ndarray
     ps: np.ndarray
-    placed: Placement
+    paths: np.ndarray
+    poses: np.ndarray
+    widths_m: np.ndarray
+    too_wide: np.ndarray
+    below_support: np.ndarray
+    collides: np.ndarray
+    placed_ok: np.ndarray
     held: np.ndarray
     depth_m: np.ndarray
     share: np.ndarray
@@ -307,57 +318,55 @@ class _TryTable:
             self.padded[at] = True
         return collides, ok
 
-    def prepare(self, paths: np.ndarray, neighbours: bool) -> None:
-        """Place the paths ``paths`` not placed yet and test their tries (:meth:`batch`) in one pass."""
+    def batch(self, paths: np.ndarray, neighbours: bool) -> _Batch:
+        """The tries of the paths ``paths`` as a :class:`_Batch`, among the neighbours (their hits are
+        collisions) or not: those not placed yet placed, and those not tested yet tested, in one pass."""
         self.place(paths)
-        self._ok(paths, neighbours)
-
-    def batch(self, paths: np.ndarray, neighbours: bool) -> "_Batch":
-        """The tries of the placed paths ``paths`` as a :class:`_Batch`, among the neighbours (their hits
-        are collisions) or not."""
         collides, ok = self._ok(paths, neighbours)
         ks, ps = np.unravel_index(paths, self.cand.costs.shape)
         flat = ok.reshape(-1)
-        placed = Placement(
-            poses=self.poses[paths].reshape(-1, 4, 4),
-            widths_m=self.widths[paths].reshape(-1),
-            lift_m=self.lift[paths].reshape(-1),
-            ok=flat,
+        return _Batch(
+            ks=ks,
+            ps=ps,
+            paths=paths,
+            poses=self.poses,
+            widths_m=self.widths,
             too_wide=self.too_wide[paths].reshape(-1),
             below_support=self.below[paths].reshape(-1),
             collides=(self.check[paths] & collides).reshape(-1),
+            placed_ok=flat,
+            held=self.held[paths].reshape(-1) & flat,
+            depth_m=np.where(flat, self.depth[paths].reshape(-1), -np.inf),
+            share=np.where(flat, self.share[paths].reshape(-1), 0.0),
         )
-        held = self.held[paths].reshape(-1) & flat
-        depth = np.where(flat, self.depth[paths].reshape(-1), -np.inf)
-        share = np.where(flat, self.share[paths].reshape(-1), 0.0)
-        return _Batch(ks, ps, placed, held, depth, share)
 
 
 class _Tries:
     """The tries of the paths of one search (``cand``'s, in ascending cost; module doc, steps 1-3 but the
-    area test), read from ``table`` as :class:`_Batch` es of :data:`PATH_BATCH` paths, among the neighbours
-    or not (``neighbours``). Paths are placed in chunks that grow with the search (:data:`PATH_BATCH` up to
-    :data:`MAX_CHUNK` paths), so a long search makes few array passes; a fallback search (step 7) reads the
-    batches again."""
+    area test), read from ``table`` among the neighbours or not (``neighbours``). Paths are placed in chunks
+    that grow with the search (:data:`PATH_BATCH` up to :data:`MAX_CHUNK` paths), so a long search makes few
+    array passes, and each chunk is read as one :class:`_Batch` of its :data:`PATH_BATCH` es; a fallback
+    search (step 7) reads the chunks again."""
 
     def __init__(self, table: _TryTable, cand: Candidates, neighbours: bool):
         self.table, self.neighbours = table, neighbours
         self.offsets, self.rolls = table.offsets, table.rolls
         self.order = np.argsort(cand.costs, axis=None, kind="stable")[: int(cand.feasible.sum())]
         self.n_batches = -(-len(self.order) // PATH_BATCH)
-        self.batches: list[_Batch] = []
-        self.placed = 0
+        self.chunks: dict[int, tuple[int, _Batch]] = {}
 
-    def batch(self, i: int) -> _Batch:
-        """The ``i``-th batch of :data:`PATH_BATCH` paths (``i < n_batches``)."""
-        while len(self.batches) <= i:
-            start = len(self.batches) * PATH_BATCH
-            if start >= self.placed:
-                size = min(max(start, PATH_BATCH), MAX_CHUNK)
-                self.table.prepare(self.order[start : start + size], self.neighbours)
-                self.placed = start + size
-            self.batches.append(self.table.batch(self.order[start : start + PATH_BATCH], self.neighbours))
-        return self.batches[i]
+    def chunk(self, i: int) -> tuple[int, _Batch]:
+        """The chunk of paths starting at the ``i``-th batch of :data:`PATH_BATCH` paths (``i < n_batches``,
+        the first batch of a chunk): the batch after its last, and its tries."""
+        if i not in self.chunks:
+            start = i * PATH_BATCH
+            size = min(max(start, PATH_BATCH), MAX_CHUNK)
+            paths = self.order[start : start + size]
+            self.chunks[i] = (
+                min(i + size // PATH_BATCH, self.n_batches),
+                self.table.batch(paths, self.neighbours),
+            )
+        return self.chunks[i]
 
 
 def _search_paths(pl, tries: _Tries, min_share: float) -> tuple[list[Candidate], dict[str, int], int, float]:
@@ -365,46 +374,62 @@ def _search_paths(pl, tries: _Tries, min_share: float) -> tuple[list[Candidate],
     :data:`PATH_BATCH`, requiring ``min_share`` of each pad's contact in the area: the passing paths
     (:class:`~graspexp.planning.details.Candidate`, up to ``shortlist``), the rejection counts, the
     number of paths examined and the largest in-area share among the tries that pass everything but the
-    area test (0 if none)."""
+    area test (0 if none). The batches of a chunk (:meth:`_Tries.chunk`) are tested together and counted
+    up to the first batch by which ``shortlist`` paths have passed: as if taken one batch at a time."""
     offsets = tries.offsets
     n_roll, n_off = len(tries.rolls), len(offsets)
+    per_path = n_roll * n_off
     by_offset = np.argsort(np.abs(offsets), kind="stable")  # tie-break: the smallest move
     rejected = dict.fromkeys(
         ("n_too_wide", "n_below_support", "n_collides", "n_weak_contact", "n_outside_area"), 0
     )
     passed: list[Candidate] = []
     examined, best_share = 0, 0.0
-    for n in range(tries.n_batches):
-        batch = tries.batch(n)
-        b = len(batch.ks)
+    n = 0
+    while n < tries.n_batches and len(passed) < pl.shortlist:
+        n, batch = tries.chunk(n)
+        ok = area_test(batch.held, batch.share, min_share)[0]
+        passes = ok.reshape(-1, per_path).any(axis=1)  # (P,)
+        # the batch by which shortlist paths have passed ends the search: count up to its end
+        reached = np.flatnonzero(len(passed) + np.cumsum(passes) >= pl.shortlist)
+        b = (
+            len(passes)
+            if not len(reached)
+            else min(len(passes), (int(reached[0]) // PATH_BATCH + 1) * PATH_BATCH)
+        )
+        t = b * per_path
         examined += b
-        ok, n_outside, batch_best = area_test(batch.held, batch.share, min_share)
-        for key, count in batch.placed.counts().items():
-            rejected[key] += count
-        rejected["n_weak_contact"] += int((batch.placed.ok & ~batch.held).sum())
+        _, n_outside, chunk_best = area_test(batch.held[:t], batch.share[:t], min_share)
+        for key, flags in (
+            ("n_too_wide", batch.too_wide),
+            ("n_below_support", batch.below_support),
+            ("n_collides", batch.collides),
+            ("n_weak_contact", batch.placed_ok & ~batch.held),
+        ):
+            rejected[key] += int(flags[:t].sum())
         rejected["n_outside_area"] += n_outside
-        best_share = max(best_share, batch_best)
-        ok, depth = ok.reshape(b, n_roll, n_off), batch.depth_m.reshape(b, n_roll, n_off)
+        best_share = max(best_share, chunk_best)
+        ok, depth = ok[:t].reshape(b, n_roll, n_off), batch.depth_m[:t].reshape(b, n_roll, n_off)
         # per path: the first roll with a passing try, then the target depth with the smallest move
-        for i in np.flatnonzero(ok.any(axis=(1, 2))):
+        for i in np.flatnonzero(passes[:b])[: pl.shortlist - len(passed)]:
             r = int(np.argmax(ok[i].any(axis=1)))
             score = np.where(ok[i, r], np.minimum(depth[i, r], pl.pad_depth_target_m), -np.inf)
             j = int(by_offset[int(np.argmax(score[by_offset]))])
-            f = (i * n_roll + r) * n_off + j
+            at = (batch.paths[i], r * n_off + j)
             passed.append(
                 Candidate(
                     cluster=int(batch.ks[i]),
                     path=int(batch.ps[i]),
-                    pose=batch.placed.poses[f],
-                    width_m=float(batch.placed.widths_m[f]),
+                    pose=batch.poses[at].copy(),
+                    width_m=float(batch.widths_m[at]),
                     pad_depth_m=float(depth[i, r, j]),
                     depth_offset_m=float(offsets[j]),
                     roll_deg=float(pl.rolls_deg[r]),
                 )
             )
-        if len(passed) >= pl.shortlist:
+        if b < len(passes):
             break
-    return passed[: pl.shortlist], rejected, examined, best_share
+    return passed, rejected, examined, best_share
 
 
 def _pads_hold(

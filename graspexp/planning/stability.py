@@ -41,7 +41,9 @@ def volume_centroid_m(points_m: np.ndarray) -> np.ndarray:
         hull = ConvexHull(p)
     except (QhullError, ValueError):
         return p.mean(axis=0)
-    apex = p[hull.vertices].mean(axis=0)
+    used = np.zeros(len(p), dtype=bool)  # hull.vertices (np.unique of the simplices) without its sort
+    used[hull.simplices] = True
+    apex = p[np.flatnonzero(used)].mean(axis=0)
     tri = p[hull.simplices]  # (F, 3, 3)
     vol = np.abs(np.einsum("ij,ij->i", tri[:, 0] - apex, np.cross(tri[:, 1] - apex, tri[:, 2] - apex))) / 6
     if vol.sum() <= 0:

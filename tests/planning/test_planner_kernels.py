@@ -18,6 +18,7 @@ from graspexp.planning import NoFeasibleGrasp, PlanRequest, plan
 from graspexp.planning.clusters import KMEANS_MAX_ITER, KMEANS_TOL, Clusters, max_radii_m, segment
 from graspexp.planning.collision import cloud_hits
 from graspexp.planning.cost import all_path_costs, distance_term
+from graspexp.planning.kernels import _extremes
 from graspexp.planning.pose import grasp_rotations, slab_spans_m
 from graspexp.planning.stability import pad_contacts
 from graspexp.run.upright import upright_pose
@@ -128,6 +129,19 @@ def test_slab_kernel_matches_the_numpy_twin_on_random_frames():
     got = slab_spans_m(pts, centers, rots, RG2)
     np.testing.assert_allclose(got, slab_spans_reference(pts, centers, rots, RG2), atol=1e-15)
     assert (got[:, 1] > got[:, 0]).all()  # every frame holds points
+
+
+def test_extremes_in_four_chains_are_one_chain_s_but_for_a_zero_s_sign():
+    """The section's and the pads' extremes (:func:`graspexp.planning.kernels._extremes`): the values of a
+    scan in point order for every length (the chains' tails), signed zeros left to the callers."""
+    rng = np.random.default_rng(6)
+    for k in range(12):
+        y = rng.normal(size=k)
+        inside = rng.random(k) < 0.6
+        y_lo, y_hi = np.where(inside, y, 1e30), np.where(inside, y, -1e30)
+        lo, hi = _extremes(y_lo, y_hi, k, 1e30)
+        assert (lo, hi) == (min([1e30, *y_lo]), max([-1e30, *y_hi]))
+    assert _extremes(np.array([0.0, -0.0, 1.0]), np.array([-0.0, 0.0, -1.0]), 3, np.inf) == (0.0, 0.0)
 
 
 def _runs_of_tries(rng: np.random.Generator, n_paths: int) -> np.ndarray:
