@@ -9,7 +9,9 @@ machine-readable :func:`stamp` that ``python -m graspexp results --check`` reads
 
 The fingerprint (:func:`outcome_fingerprint`) hashes the outcomes of a small fixed set of trials (every
 result column of :data:`OUTCOME_COLUMNS`, as text, so a float that moves in its last digit counts): a
-refactoring that changes no trial keeps it, a change that moves one trial changes it.
+refactoring that changes no trial keeps it, a change that moves one trial changes it. Those last digits
+depend on the CPU's instruction set as well (:func:`graspexp.run.provenance.cpu_class`), so each stamp
+names the CPU class its fingerprint holds on, and a page may carry one stamp per class (:func:`add_stamp`).
 """
 
 from __future__ import annotations
@@ -29,7 +31,8 @@ BEGIN = (
 END = "<!-- graspexp results: end of the generated block -->"
 """The line that closes it."""
 _STAMP = re.compile(
-    r"<!-- graspexp results page=(?P<page>\S+) fingerprint=(?P<fp>[0-9a-f]+) commit=(?P<commit>\S+) -->"
+    r"<!-- graspexp results page=(?P<page>\S+) fingerprint=(?P<fp>[0-9a-f]+) commit=(?P<commit>\S+)"
+    r"(?: cpu=(?P<cpu>\S+))? -->"
 )
 
 OUTCOME_KEYS: tuple[str, ...] = ("dataset", "object", "mode", "rot", "planner", "trial")
@@ -91,11 +94,13 @@ class PageError(ValueError):
 
 @dataclass(frozen=True)
 class Stamp:
-    """What a page records about its generated block: page name, fingerprint and commit."""
+    """What a page records about its generated block: page name, fingerprint, the commit it was taken at and
+    the CPU class it holds on ("": not recorded, a page stamped before classes were)."""
 
     page: str
     fingerprint: str
     commit: str
+    cpu: str = ""
 
 
 def outcome_fingerprint(tables: Iterable[pd.DataFrame]) -> str:
@@ -118,14 +123,51 @@ def outcome_fingerprint(tables: Iterable[pd.DataFrame]) -> str:
 
 
 def stamp(s: Stamp) -> str:
-    """The machine-readable line of a page's block (:func:`read_stamp` parses it)."""
-    return f"<!-- graspexp results page={s.page} fingerprint={s.fingerprint} commit={s.commit} -->"
+    """The machine-readable line of a page's block (:func:`read_stamps` parses it)."""
+    cpu = f" cpu={s.cpu}" if s.cpu else ""
+    return f"<!-- graspexp results page={s.page} fingerprint={s.fingerprint} commit={s.commit}{cpu} -->"
+
+
+def read_stamps(text: str) -> list[Stamp]:
+    """Every :class:`Stamp` of a page's text, the one its block was made with first; [] when it has none
+    (never generated)."""
+    return [Stamp(m["page"], m["fp"], m["commit"], m["cpu"] or "") for m in _STAMP.finditer(text)]
 
 
 def read_stamp(text: str) -> Stamp | None:
-    """The :class:`Stamp` of a page's text, or None when it has none (never generated)."""
-    m = _STAMP.search(text)
-    return Stamp(m["page"], m["fp"], m["commit"]) if m else None
+    """The first :class:`Stamp` of a page's text (the one its block was made with), or None."""
+    stamps = read_stamps(text)
+    return stamps[0] if stamps else None
+
+
+def add_stamp(text: str, s: Stamp, where: str) -> str:
+    """``text`` with the stamp ``s`` (another CPU class's fingerprint of the same numbers) after the block's
+    stamps, in place of an earlier one of the same class. PageError when the page has no stamp, or when its
+    block was made on that class (regenerate it instead)."""
+    lines = text.split("\n")
+    at = [i for i, ln in enumerate(lines) if _STAMP.fullmatch(ln.strip())]
+    if not at:
+        raise PageError(f"{where}: no stamp of a generated block to add one beside")
+    if read_stamp(lines[at[0]]).cpu == s.cpu:
+        raise PageError(
+            f"{where}: its block was made on {s.cpu or 'an unrecorded class'}; regenerate it instead"
+        )
+    drop = {i for i in at[1:] if read_stamp(lines[i]).cpu == s.cpu}
+    last = max(i for i in at if i not in drop)
+    out = []
+    for i, line in enumerate(lines):
+        if i not in drop:
+            out.append(line)
+        if i == last:
+            out.append(stamp(s))
+    return "\n".join(out)
+
+
+def stamp_for(stamps: list[Stamp], cpu: str) -> Stamp | None:
+    """The stamp of ``stamps`` that a machine of CPU class ``cpu`` checks: its own class's, else one without
+    a class (made before classes were recorded: checked on any class without a stamp of its own), else
+    None (not checkable there)."""
+    return next((s for s in stamps if s.cpu == cpu), None) or next((s for s in stamps if not s.cpu), None)
 
 
 def replace_block(text: str, block: str, where: str) -> str:
@@ -171,6 +213,8 @@ class Provenance:
     """Each fingerprint job's overrides, space-separated."""
     sweep_commits: tuple[str, ...] = ()
     """The commits the sweeps ran at, where a resumed regeneration reused sweeps of another commit."""
+    cpu: str = ""
+    """The CPU class the fingerprint was taken on (:func:`graspexp.run.provenance.cpu_class`)."""
 
 
 def provenance(p: Provenance, admonition: bool = True) -> str:
@@ -188,11 +232,12 @@ def provenance(p: Provenance, admonition: bool = True) -> str:
         f"Fingerprint `{p.fingerprint}`: the outcomes of {p.fingerprint_trials} fixed trials "
         f"({len(p.fingerprint_jobs)} jobs of this page's planners and settings, `record=false`). "
         "`python -m graspexp results --check` re-runs them and lists every page whose fingerprint the code "
-        "no longer reproduces.",
+        "no longer reproduces"
+        + (f" (bit for bit on the CPU class it was taken on, {p.cpu})." if p.cpu else "."),
     ]
     if admonition:
         text = ['!!! info "How these numbers were made"', *(f"    {t}" if t else "" for t in text)]
-    return "\n".join([stamp(Stamp(p.page, p.fingerprint, p.commit)), "", *text, ""])
+    return "\n".join([stamp(Stamp(p.page, p.fingerprint, p.commit, p.cpu)), "", *text, ""])
 
 
 def embed(markdown_text: str, shift: int = 1, prefix: str = "") -> str:

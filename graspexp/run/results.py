@@ -44,13 +44,17 @@ import pandas as pd
 from graspexp.core.run_layout import ATTEMPTS_CSV, results_csv
 from graspexp.report.pages import (
     Provenance,
+    Stamp,
+    add_stamp,
     duration,
     outcome_fingerprint,
     provenance,
-    read_stamp,
+    read_stamps,
     replace_block,
+    stamp_for,
 )
 from graspexp.run.multirun import multirun_command
+from graspexp.run.provenance import cpu_class, machine_fingerprint
 from graspexp.run.suites import Reading, reading_sweep
 
 FINGERPRINT_SETTINGS: tuple[tuple[str, str], ...] = (("collab", "z"), ("bin", "xyz"))
@@ -252,8 +256,6 @@ def commit_of(root: Path) -> tuple[str, str]:
 
 def describe_machine() -> str:
     """What the machine is, in words: cores, architecture, VM or not, CPU model, the physics backend."""
-    from graspexp.run.provenance import machine_fingerprint
-
     cpu = machine_fingerprint()["cpu"]
     try:
         flags = next(
@@ -269,7 +271,7 @@ def describe_machine() -> str:
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     arch = {"x86_64": "x86-64", "aarch64": "arm64"}.get(platform.machine(), platform.machine())
     kind = "VM" if "hypervisor" in flags else "machine"
-    return f"a {cores}-core {arch} {kind} ({cpu}), CPU PhysX"
+    return f"a {cores}-core {arch} {kind} ({cpu}, {cpu_class()}), CPU PhysX"
 
 
 def _remote(overrides: Sequence[str]) -> bool:
@@ -360,6 +362,7 @@ def regenerate(
                 fingerprint_trials=_fingerprint_trials(jobs),
                 fingerprint_jobs=tuple(" ".join(j) for j in jobs),
                 sweep_commits=tuple(t.commit or "unknown" for t in own),
+                cpu=cpu_class(),
             ),
             page.admonition,
         )
@@ -391,21 +394,32 @@ def _fingerprint_trials(jobs: Sequence[Sequence[str]]) -> int:
 
 
 def check(pages: Sequence[Page], root: Path, n_jobs: int) -> list[str]:
-    """One line per page of ``pages`` whose recorded fingerprint the current code does not reproduce (or
-    that records none); [] when every page is current. A page whose planners cannot run here is skipped
-    (:func:`available`)."""
+    """One line per page of ``pages`` whose fingerprint for this machine's CPU class (:func:`.pages.stamp_for`)
+    the current code does not reproduce (or that records none); [] when every page is current. A page whose
+    planners cannot run here is skipped (:func:`available`), and so, with a line saying so, is a page that
+    records fingerprints of other CPU classes only (its last digits are not this machine's to check)."""
     pages = available(pages)
+    cpu = cpu_class()
     recorded = {}
     problems = []
     for page in pages:
         path = root / page.path
-        stamp = read_stamp(path.read_text()) if path.is_file() else None
-        if stamp is None or stamp.page != page.name:
+        stamps = [s for s in read_stamps(path.read_text()) if s.page == page.name] if path.is_file() else []
+        mine = stamp_for(stamps, cpu)
+        if not stamps:
             problems.append(
                 f"{page.path}: no fingerprint of page {page.name!r}: run python -m graspexp results"
             )
+        elif mine is None:
+            classes = ", ".join(sorted({s.cpu for s in stamps}))
+            print(
+                f"graspexp results: {page.path}: fingerprints of {classes} only, not checkable on this "
+                f"machine ({cpu}); `python -m graspexp results --stamp-cpu` adds this class's on one where "
+                "the page is current",
+                file=sys.stderr,
+            )
         else:
-            recorded[page.name] = stamp
+            recorded[page.name] = mine
     with tempfile.TemporaryDirectory(prefix="graspexp-results-check-") as tmp:
         stamped = [p for p in pages if p.name in recorded]
         now = run_fingerprints(stamped, Path(tmp), n_jobs) if stamped else {}
@@ -415,9 +429,39 @@ def check(pages: Sequence[Page], root: Path, n_jobs: int) -> list[str]:
             continue
         if now[page.name] != stamp.fingerprint:
             problems.append(
-                f"{page.path}: made at commit {stamp.commit} (fingerprint {stamp.fingerprint}); the current code "
-                f"gives {now[page.name]}: regenerate it with python -m graspexp results --pages {page.name}"
+                f"{page.path}: made at commit {stamp.commit} (fingerprint {stamp.fingerprint}"
+                f"{', ' + stamp.cpu if stamp.cpu else ''}); the current code gives {now[page.name]}: "
+                f"regenerate it with python -m graspexp results --pages {page.name}"
             )
         else:
             print(f"graspexp results: {page.path}: current ({stamp.fingerprint})", file=sys.stderr)
+    return problems
+
+
+def stamp_cpu(pages: Sequence[Page], root: Path, n_jobs: int) -> list[str]:
+    """Record this machine's CPU class's fingerprint beside the stamps of each page of ``pages`` that has
+    none of this class, from the current code; [] or one line per page left alone (never generated; made on
+    this class: regenerate it). Run it at a commit whose pages are current on the class they were made on
+    (``results --check`` there): the new stamp then says what the same code gives on this class."""
+    pages = available(pages)
+    cpu = cpu_class()
+    problems, todo = [], []
+    for page in pages:
+        path = root / page.path
+        stamps = [s for s in read_stamps(path.read_text()) if s.page == page.name] if path.is_file() else []
+        if not stamps:
+            problems.append(
+                f"{page.path}: no fingerprint of page {page.name!r}: run python -m graspexp results"
+            )
+        elif stamps[0].cpu == cpu:
+            print(f"graspexp results: {page.path}: made on {cpu}, nothing to add", file=sys.stderr)
+        else:
+            todo.append(page)
+    commit = commit_of(root)[0]
+    with tempfile.TemporaryDirectory(prefix="graspexp-results-stamp-") as tmp:
+        now = run_fingerprints(todo, Path(tmp), n_jobs) if todo else {}
+    for page in todo:
+        path = root / page.path
+        path.write_text(add_stamp(path.read_text(), Stamp(page.name, now[page.name], commit, cpu), str(path)))
+        print(f"graspexp results: {page.path}: {cpu} fingerprint {now[page.name]} added", file=sys.stderr)
     return problems

@@ -1,6 +1,9 @@
-"""``python -m graspexp results [--check] [--pages a,b] [--out OUT] [--root DIR] [--n-jobs N] [key=value ...]``:
+"""``python -m graspexp results [--check | --stamp-cpu] [--pages a,b] [--out OUT] [--root DIR] [--n-jobs N] [key=value ...]``:
 regenerate every results page (``docs/results/*.md`` and the README's results table) from runs of the
 current code, or with ``--check`` list the pages whose fingerprint the current code does not reproduce.
+A fingerprint holds bit for bit on one CPU class (``x86_64-v3``: AVX2; ``x86_64-v4``: AVX-512): ``--check``
+compares this machine's class's and skips, with a line, a page stamped on other classes only;
+``--stamp-cpu`` adds this class's fingerprints to the pages made on another (run it where they are current).
 
 Each page's sweeps run as Hydra multiruns (joblib launcher) into ``OUT/runs/`` (default
 ``outputs/results/<commit>``); running the command again continues an interrupted regeneration.
@@ -16,7 +19,7 @@ from pathlib import Path
 
 from graspexp.report.pages import PageError
 from graspexp.run.result_pages import PAGES
-from graspexp.run.results import ResultsError, check, commit_of, regenerate
+from graspexp.run.results import ResultsError, check, commit_of, regenerate, stamp_cpu
 from graspexp.tools.cli import fail, positive_int, tool_parser
 
 PROG = "graspexp results"
@@ -27,6 +30,12 @@ def main(argv: list[str] | None = None) -> int:
     ap = tool_parser(PROG, __doc__.splitlines()[1], overrides=True)
     ap.add_argument(
         "--check", action="store_true", help="re-run the fingerprints; list the pages not current"
+    )
+    ap.add_argument(
+        "--stamp-cpu",
+        action="store_true",
+        help="add this machine's CPU class's fingerprints to the pages made on another class (run it where "
+        "those pages are current)",
     )
     ap.add_argument(
         "--pages", default="", help=f"comma-separated (default all: {', '.join(p.name for p in PAGES)})"
@@ -45,7 +54,11 @@ def main(argv: list[str] | None = None) -> int:
     out = args.out if args.out is not None else Path("outputs/results") / commit_of(args.root)[0]
     command = shlex.join(["python", "-m", "graspexp", "results", *argv])
     try:
-        if args.check:
+        if args.check and args.stamp_cpu:
+            fail("--check and --stamp-cpu are two runs: check where the pages were made, stamp here", PROG)
+        if args.stamp_cpu:
+            problems = stamp_cpu(pages, args.root, args.n_jobs)
+        elif args.check:
             problems = check(pages, args.root, args.n_jobs)
         else:
             problems = regenerate(pages, args.root, out, args.overrides, command, args.n_jobs)

@@ -1,6 +1,7 @@
 """``python -m graspexp results``: the page registry, the generated block, the fingerprint, and the
 staleness check, which fails when a planner's code changes and passes otherwise."""
 
+import dataclasses
 import subprocess
 import sys
 import textwrap
@@ -22,11 +23,14 @@ from graspexp.report.pages import (
     OUTCOME_KEYS,
     PageError,
     Stamp,
+    add_stamp,
     outcome_fingerprint,
     read_stamp,
+    read_stamps,
     replace_block,
     stamp,
 )
+from graspexp.run.provenance import cpu_class
 from graspexp.run.result_pages import PAGES
 from graspexp.run.results import check, commit_of, fingerprint_jobs, merged, regenerate
 from graspexp.tools.results import main as results_main
@@ -134,6 +138,7 @@ def test_check_passes_on_the_same_code_and_fails_when_a_planner_changes(tmp_path
     assert regenerate([page], tmp_path, tmp_path / "out", [], "python -m graspexp results", 1) == []
     text = (tmp_path / "page.md").read_text()
     assert "the tables" in text and "2 fixed trials" in text and "2 jobs" in text
+    assert read_stamp(text).cpu == cpu_class() and f"CPU class it was taken on, {cpu_class()}" in text
     assert check([page], tmp_path, 1) == []
     script = textwrap.dedent(
         f"""
@@ -289,3 +294,39 @@ def test_a_clutter_fingerprint_hashes_attempt_outcomes_not_their_times():
         "mode",
         "planner",
     }
+
+
+def test_a_fingerprint_is_checked_on_its_own_cpu_class_and_stamped_for_another(tmp_path, monkeypatch, capsys):
+    """The last digits of a trial depend on the CPU's instruction set: a page stamped on another class only
+    is skipped by ``--check`` with a line, ``--stamp-cpu`` adds this class's fingerprint (replacing an older
+    one of the class), and a stamp without a class (made before classes were recorded) is checked anywhere."""
+    from graspexp.run import results
+
+    page = dataclasses.replace(next(p for p in PAGES if p.name == "index"), path="page.md")
+    gives = {"fp": "1111"}
+    monkeypatch.setattr(results, "run_fingerprints", lambda pages, *a: {p.name: gives["fp"] for p in pages})
+    monkeypatch.setattr(results, "cpu_class", lambda: "x86_64-v4")
+    path = tmp_path / "page.md"
+    made = Stamp("index", "0000", "abc1234", "x86_64-v3")
+    path.write_text(f"# P\n\n{BEGIN}\n{stamp(made)}\n\ntables\n{END}\n")
+    assert results.check([page], tmp_path, 1) == []
+    assert (
+        "fingerprints of x86_64-v3 only, not checkable on this machine (x86_64-v4)" in capsys.readouterr().err
+    )
+    assert results.stamp_cpu([page], tmp_path, 1) == []
+    assert [(s.cpu, s.fingerprint) for s in read_stamps(path.read_text())] == [
+        ("x86_64-v3", "0000"),
+        ("x86_64-v4", "1111"),
+    ]
+    assert results.check([page], tmp_path, 1) == []
+    gives["fp"] = "2222"  # the code changed
+    (problem,) = results.check([page], tmp_path, 1)
+    assert "fingerprint 1111, x86_64-v4" in problem and "gives 2222" in problem
+    assert results.stamp_cpu([page], tmp_path, 1) == []
+    assert [s.fingerprint for s in read_stamps(path.read_text())] == ["0000", "2222"]
+    path.write_text(f"# P\n\n{BEGIN}\n{stamp(Stamp('index', '0000', 'abc1234'))}\n\ntables\n{END}\n")
+    assert "fingerprint 0000)" in results.check([page], tmp_path, 1)[0]  # unclassed: checked here
+    path.write_text(f"# P\n\n{BEGIN}\n{stamp(Stamp('index', '2222', 'abc1234', 'x86_64-v4'))}\n{END}\n")
+    assert results.stamp_cpu([page], tmp_path, 1) == [] and len(read_stamps(path.read_text())) == 1
+    with pytest.raises(PageError, match="made on x86_64-v4; regenerate it instead"):
+        add_stamp(path.read_text(), Stamp("index", "3333", "def", "x86_64-v4"), "page.md")
