@@ -47,7 +47,7 @@ def _install_learned(session: nox.Session) -> bool:
 def learned(session: nox.Session) -> None:
     """The learned planners' tests (``-m learned``: planner=vgn loads its checkpoint, gives the same outputs
     every time, plans on a rendered scene) with the optional extra ``learned`` installed, then the
-    fingerprints of the results pages that run them (``results --check --pages camera,learned``: skipped by
+    fingerprints of the results pages that run them (``results --check --pages camera,learned,clutter_camera``: skipped by
     the check without the extra); skipped with one line where the extra cannot be installed."""
     session.install("-e", ".[test]", "-c", "constraints.txt")
     if not _install_learned(session):
