@@ -12,7 +12,7 @@ from helpers.logs import strictly_valid
 
 from graspexp.record import read_trial
 
-pytestmark = [pytest.mark.sim, pytest.mark.slow]
+pytestmark = pytest.mark.slow
 REPO = Path(__file__).resolve().parents[2]
 SMALL_CAMERA = (
     "perception.camera.width_px=160",
