@@ -57,6 +57,19 @@ X86_V3 = frozenset({"avx", "avx2", "bmi1", "bmi2", "f16c", "fma", "movbe"})
 
 
 @functools.cache
+def cpu_flags() -> frozenset[str] | None:
+    """The CPU's instruction-set flags (the first ``flags`` line of /proc/cpuinfo; empty where it has none),
+    or None when /proc/cpuinfo cannot be read."""
+    try:
+        lines = Path("/proc/cpuinfo").read_text().splitlines()
+    except OSError:
+        return None
+    return next(
+        (frozenset(ln.split(":", 1)[1].split()) for ln in lines if ln.startswith("flags")), frozenset()
+    )
+
+
+@functools.cache
 def cpu_class() -> str:
     """The CPU class a results fingerprint holds on (``x86_64-v4``, ``x86_64-v3``, ``x86_64-v2``, or the
     architecture's name elsewhere): numpy's vector loops, OpenBLAS's kernels and numba's code are chosen by
@@ -66,13 +79,8 @@ def cpu_class() -> str:
     arch = platform.machine()
     if arch != "x86_64":
         return arch or "unknown"
-    try:
-        flags = next(
-            (set(ln.split(":", 1)[1].split()) for ln in Path("/proc/cpuinfo").read_text().splitlines()
-             if ln.startswith("flags")),
-            set(),
-        )  # fmt: skip
-    except OSError:
+    flags = cpu_flags()
+    if flags is None:
         return "x86_64"
     level = 4 if X86_V4 <= flags and X86_V3 <= flags else 3 if X86_V3 <= flags else 2
     return f"x86_64-v{level}"

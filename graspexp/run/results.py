@@ -54,7 +54,7 @@ from graspexp.report.pages import (
     stamp_for,
 )
 from graspexp.run.multirun import multirun_command
-from graspexp.run.provenance import cpu_class, machine_fingerprint
+from graspexp.run.provenance import cpu_class, cpu_flags, machine_fingerprint
 from graspexp.run.suites import Reading, reading_sweep
 
 FINGERPRINT_SETTINGS: tuple[tuple[str, str], ...] = (("collab", "z"), ("bin", "xyz"))
@@ -257,20 +257,9 @@ def commit_of(root: Path) -> tuple[str, str]:
 def describe_machine() -> str:
     """What the machine is, in words: cores, architecture, VM or not, CPU model, the physics backend."""
     cpu = machine_fingerprint()["cpu"]
-    try:
-        flags = next(
-            (
-                ln.split(":", 1)[1].split()
-                for ln in Path("/proc/cpuinfo").read_text().splitlines()
-                if ln.startswith("flags")
-            ),
-            [],
-        )
-    except OSError:
-        flags = []
     cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     arch = {"x86_64": "x86-64", "aarch64": "arm64"}.get(platform.machine(), platform.machine())
-    kind = "VM" if "hypervisor" in flags else "machine"
+    kind = "VM" if "hypervisor" in (cpu_flags() or ()) else "machine"
     return f"a {cores}-core {arch} {kind} ({cpu}, {cpu_class()}), CPU PhysX"
 
 
@@ -393,6 +382,16 @@ def _fingerprint_trials(jobs: Sequence[Sequence[str]]) -> int:
     return n
 
 
+def _page_stamps(page: Page, root: Path) -> list[Stamp]:
+    """The stamps of ``page`` in its file under ``root`` ([] when it has none or no file)."""
+    path = root / page.path
+    return [s for s in read_stamps(path.read_text()) if s.page == page.name] if path.is_file() else []
+
+
+def _unstamped(page: Page) -> str:
+    return f"{page.path}: no fingerprint of page {page.name!r}: run python -m graspexp results"
+
+
 def check(pages: Sequence[Page], root: Path, n_jobs: int) -> list[str]:
     """One line per page of ``pages`` whose fingerprint for this machine's CPU class (:func:`.pages.stamp_for`)
     the current code does not reproduce (or that records none); [] when every page is current. A page whose
@@ -403,13 +402,10 @@ def check(pages: Sequence[Page], root: Path, n_jobs: int) -> list[str]:
     recorded = {}
     problems = []
     for page in pages:
-        path = root / page.path
-        stamps = [s for s in read_stamps(path.read_text()) if s.page == page.name] if path.is_file() else []
+        stamps = _page_stamps(page, root)
         mine = stamp_for(stamps, cpu)
         if not stamps:
-            problems.append(
-                f"{page.path}: no fingerprint of page {page.name!r}: run python -m graspexp results"
-            )
+            problems.append(_unstamped(page))
         elif mine is None:
             classes = ", ".join(sorted({s.cpu for s in stamps}))
             print(
@@ -447,12 +443,9 @@ def stamp_cpu(pages: Sequence[Page], root: Path, n_jobs: int) -> list[str]:
     cpu = cpu_class()
     problems, todo = [], []
     for page in pages:
-        path = root / page.path
-        stamps = [s for s in read_stamps(path.read_text()) if s.page == page.name] if path.is_file() else []
+        stamps = _page_stamps(page, root)
         if not stamps:
-            problems.append(
-                f"{page.path}: no fingerprint of page {page.name!r}: run python -m graspexp results"
-            )
+            problems.append(_unstamped(page))
         elif stamps[0].cpu == cpu:
             print(f"graspexp results: {page.path}: made on {cpu}, nothing to add", file=sys.stderr)
         else:
