@@ -348,11 +348,6 @@ def _slab_span(
     # A second, scalar pass: LLVM does not vectorise float min/max reductions without function-wide
     # no-NaN attributes, which numba does not set; fused into the first pass they halve its speed.
     lo, hi = _extremes(y_lo, y_hi, k, big)
-    if lo == 0.0 or hi == 0.0:  # which of +0 and -0: the first in point order, as one chain keeps it
-        lo, hi = big, -big
-        for i in range(k):
-            lo = y_lo[i] if y_lo[i] < lo else lo
-            hi = y_hi[i] if y_hi[i] > hi else hi
     if lo <= hi:  # some point was inside
         out[0] = lo
         out[1] = hi
@@ -487,11 +482,6 @@ def _pad_reach(
         y_lo[i] = y if inside else np.inf
         y_hi[i] = y if inside else -np.inf
     lo, hi = _extremes(y_lo, y_hi, k, np.inf)
-    if lo == 0.0 or hi == 0.0:  # which of +0 and -0: the first in point order, as one chain keeps it
-        lo, hi = np.inf, -np.inf
-        for i in range(k):  # selects, no branches
-            lo = y_lo[i] if y_lo[i] < lo else lo
-            hi = y_hi[i] if y_hi[i] > hi else hi
     return lo, hi
 
 
@@ -500,7 +490,7 @@ def _extremes(y_lo: np.ndarray, y_hi: np.ndarray, k: int, big: float) -> tuple[f
     """The smallest of ``y_lo[:k]`` and ``big`` and the largest of ``y_hi[:k]`` and ``-big`` (no NaN), in
     four independent chains of selects each (one chain waits on every compare: four run at once). The
     extremes' values are those of one chain; only a zero's sign may differ (+0 and -0 compare equal, and
-    one chain keeps the first in order): the callers redo a zero in one chain."""
+    one chain keeps the first in order), so a zero is redone in one chain."""
     l0, l1, l2, l3 = big, big, big, big
     h0, h1, h2, h3 = -big, -big, -big, -big
     k4 = k - k % 4
@@ -518,7 +508,13 @@ def _extremes(y_lo: np.ndarray, y_hi: np.ndarray, k: int, big: float) -> tuple[f
         h0 = y_hi[i] if y_hi[i] > h0 else h0
     l0, l2 = (l1 if l1 < l0 else l0), (l3 if l3 < l2 else l2)
     h0, h2 = (h1 if h1 > h0 else h0), (h3 if h3 > h2 else h2)
-    return (l2 if l2 < l0 else l0), (h2 if h2 > h0 else h0)
+    lo, hi = (l2 if l2 < l0 else l0), (h2 if h2 > h0 else h0)
+    if lo == 0.0 or hi == 0.0:  # which of +0 and -0: the first in point order, as one chain keeps it
+        lo, hi = big, -big
+        for i in range(k):  # selects, no branches
+            lo = y_lo[i] if y_lo[i] < lo else lo
+            hi = y_hi[i] if y_hi[i] > hi else hi
+    return lo, hi
 
 
 @_jit

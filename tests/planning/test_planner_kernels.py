@@ -131,9 +131,9 @@ def test_slab_kernel_matches_the_numpy_twin_on_random_frames():
     assert (got[:, 1] > got[:, 0]).all()  # every frame holds points
 
 
-def test_extremes_in_four_chains_are_one_chain_s_but_for_a_zero_s_sign():
+def test_extremes_in_four_chains_are_one_chain_s_signed_zeros_included():
     """The section's and the pads' extremes (:func:`graspexp.planning.kernels._extremes`): the values of a
-    scan in point order for every length (the chains' tails), signed zeros left to the callers."""
+    scan in point order for every length (the chains' tails), a zero with the sign of the first in order."""
     rng = np.random.default_rng(6)
     for k in range(12):
         y = rng.normal(size=k)
@@ -141,7 +141,8 @@ def test_extremes_in_four_chains_are_one_chain_s_but_for_a_zero_s_sign():
         y_lo, y_hi = np.where(inside, y, 1e30), np.where(inside, y, -1e30)
         lo, hi = _extremes(y_lo, y_hi, k, 1e30)
         assert (lo, hi) == (min([1e30, *y_lo]), max([-1e30, *y_hi]))
-    assert _extremes(np.array([0.0, -0.0, 1.0]), np.array([-0.0, 0.0, -1.0]), 3, np.inf) == (0.0, 0.0)
+    lo, hi = _extremes(np.array([0.0, -0.0, 1.0]), np.array([-0.0, 0.0, -1.0]), 3, np.inf)
+    assert (lo, hi) == (0.0, 0.0) and not np.signbit(lo) and np.signbit(hi)
 
 
 def _runs_of_tries(rng: np.random.Generator, n_paths: int) -> np.ndarray:
