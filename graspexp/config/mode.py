@@ -13,7 +13,7 @@ class ModeConfig:
     name: str = MISSING
     """``collab`` (Eq. 1; box removed after the grasp) or ``bin`` (Eq. 2-3; table, pull back): one object per
     trial; ``pile`` or ``packed``: a clutter-removal round of :attr:`objects_per_round` objects on the table,
-    grasped one at a time (Eq. 2-3, pull back and lift as in ``bin``; :mod:`graspexp.sim.clutter`)."""
+    grasped one at a time (Eq. 2-3, pull back and lift as in ``bin``; :mod:`graspexp.sim.rounds`)."""
     support_height_m: float = 0.10
     """Height of the support's top face above the ground plane, m (the plane z = h)."""
     support_half_size_m: list[float] = MISSING
@@ -76,7 +76,7 @@ class ModeConfig:
 
 
 CLUTTER_MODES = ("pile", "packed")
-"""The modes whose trials are clutter-removal rounds (:mod:`graspexp.sim.clutter`)."""
+"""The modes whose trials are clutter-removal rounds (:mod:`graspexp.sim.rounds`)."""
 PICK_ORDERS = ("lowest_cost", "top_most")
 """The values of ``mode.pick_order``."""
 

@@ -18,8 +18,8 @@ import math
 import types
 import typing
 
-from graspexp.core.clutter import AttemptResult, RoundResult
 from graspexp.core.outcome import TrialResult
+from graspexp.core.rounds import AttemptResult, RoundResult
 
 SCHEMA_ENCODING = "jsonschema"
 MESSAGE_ENCODING = "json"
@@ -55,7 +55,7 @@ TOPIC_CALIBRATION = "/camera/calibration"
 TOPIC_CLOUD = "/camera/cloud"
 TOPIC_PERCEPTION = "/perception"
 TOPIC_ROUND = "/round"
-"""A clutter round's log (``mode=pile``/``packed``): its :class:`graspexp.core.clutter.RoundResult` with every
+"""A clutter round's log (``mode=pile``/``packed``): its :class:`graspexp.core.rounds.RoundResult` with every
 attempt, in place of ``/result`` (created on first use: a trial's log has none)."""
 LAZY_TOPICS = (TOPIC_ROUND,)
 CAMERA_TOPICS = (TOPIC_DEPTH, TOPIC_IDS, TOPIC_CALIBRATION, TOPIC_CLOUD, TOPIC_PERCEPTION)

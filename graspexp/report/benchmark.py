@@ -7,13 +7,13 @@ from pathlib import Path
 
 import pandas as pd
 
-from graspexp.core.clutter import RoundResult
-from graspexp.report.clutter import clutter_table, table_markdown
+from graspexp.core.rounds import RoundResult
 from graspexp.report.compare import FC_MU, check_same_drops, render_markdown
 from graspexp.report.compare import success_by_noise as noise_success_table
 from graspexp.report.contact_area import IN_AREA_TOLERANCE_M
 from graspexp.report.paper import PAPER_TABLES, SETTINGS
 from graspexp.report.render import display_frame, footnotes, markdown
+from graspexp.report.round_tables import clutter_table, table_markdown
 from graspexp.report.stats import percentiles, success_pct
 from graspexp.report.tables import failure_breakdown, success_table
 

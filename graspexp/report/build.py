@@ -18,12 +18,11 @@ from pathlib import Path
 
 import pandas as pd
 
-from graspexp.core.clutter import RoundResult
+from graspexp.core.rounds import RoundResult
 from graspexp.record import CorruptLogError, read_trial
 from graspexp.report.agreement import Agreement, agreement, agreement_chart, example_trials
 from graspexp.report.charts import success_chart
 from graspexp.report.citations import DETERMINISM
-from graspexp.report.clutter import clutter_markdown, clutter_table, find_rounds
 from graspexp.report.clutter_strips import write_clutter_strips
 from graspexp.report.collect import FINGERPRINT_COLUMN, Collected, collect
 from graspexp.report.contact_area import held_in_area
@@ -31,6 +30,7 @@ from graspexp.report.gallery import draw_trial, write_gallery
 from graspexp.report.paper import PLANNER_RUNTIME_S
 from graspexp.report.pose_error import success_by_pose_error
 from graspexp.report.render import display_frame, fmt_pct, footnotes, latex, markdown
+from graspexp.report.round_tables import clutter_markdown, clutter_table, find_rounds
 from graspexp.report.tables import (
     IN_AREA_COLUMN,
     STRICT_SLIP_M,
@@ -179,7 +179,7 @@ def agreement_section(ag: Agreement, results: pd.DataFrame, out: Path) -> list[s
 
 
 def clutter_section(rounds: list[RoundResult], out: Path) -> list[str]:
-    """Write ``clutter.md``/``clutter.csv`` (:func:`graspexp.report.clutter.clutter_table`); the report's lines."""
+    """Write ``clutter.md``/``clutter.csv`` (:func:`graspexp.report.round_tables.clutter_table`); the report's lines."""
     text = clutter_markdown(rounds)
     (out / "clutter.md").write_text(text + "\n")
     clutter_table(rounds).to_csv(out / "clutter.csv", index=False)

@@ -109,7 +109,7 @@ def _log_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
                 raise CorruptLogError(f"{path}: its recorded config is not a job config")
             result_from_dict(result)
         except (CorruptLogError, OSError, ValueError) as exc:
-            if not _is_round_log(path):  # a clutter round's log is read by graspexp.report.clutter
+            if not _is_round_log(path):  # a clutter round's log is read by graspexp.report.round_tables
                 unreadable.append((path, str(exc) if str(path) in str(exc) else f"{path}: {exc}"))
             continue
         row = _row(result, path, noise_of(config))

@@ -84,7 +84,7 @@ ATTEMPT_COLUMNS: tuple[str, ...] = (
     "sim_time_s",
 )
 """The attempts.csv columns a clutter page's fingerprint hashes
-(:class:`graspexp.core.clutter.AttemptResult`): every outcome, not the time measurements (``plan_s``,
+(:class:`graspexp.core.rounds.AttemptResult`): every outcome, not the time measurements (``plan_s``,
 ``plan_cpu_s``, ``execute_s``)."""
 
 

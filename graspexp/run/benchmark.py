@@ -15,13 +15,13 @@ import pandas as pd
 
 from graspexp.config.mode import CLUTTER_MODES
 from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
-from graspexp.core.clutter import RoundResult
+from graspexp.core.rounds import RoundResult
 from graspexp.core.run_layout import ROUNDS_CSV, SUMMARY_MD, results_csv
 from graspexp.report.benchmark import clutter_lines, summary_lines
-from graspexp.report.clutter import find_rounds
 from graspexp.report.collect import collect
 from graspexp.report.contact_area import finger_contacts_in_area
 from graspexp.report.paper import PAPER_TABLES, SETTINGS, TRIALS_PER_SETTING
+from graspexp.report.round_tables import find_rounds
 from graspexp.run.multirun import multirun_command
 from graspexp.run.provenance import package_versions
 from graspexp.run.suites import NOISE_LEVELS, Job, benchmark_suite

@@ -1,6 +1,6 @@
 """A job's objects made ready for their trials (model, collision shape, Foxglove scene), and the one
 place a trial's context is set up from a config and an object: the runner, re-simulation, the benches and
-the tests all go through :func:`load_object` and :func:`trial_context`."""
+the tests all go through :func:`load_sim_object` and :func:`trial_context`."""
 
 import dataclasses
 import logging
@@ -33,7 +33,7 @@ class LoadedObject:
     """The model's notes (units, mass, area) and the collision shape's (a fallback method)."""
 
 
-def load_object(cfg: DictConfig, name: str, plain: JobConfig | None = None) -> LoadedObject:
+def load_sim_object(cfg: DictConfig, name: str, plain: JobConfig | None = None) -> LoadedObject:
     """Object ``name`` of job config ``cfg`` (``plain``: the same config as dataclasses, made here if None)
     with its collision shape (the configured method, else the fallback: the note says so) and scene.
     Raises :class:`ObjectError` for an unusable mesh, sidecar or area, :class:`ShapeError` when no shape
@@ -54,7 +54,7 @@ def load_models(cfg: DictConfig, objects: list[str]) -> tuple[dict[str, LoadedOb
     out, failed = {}, {}
     for name in objects:
         try:
-            out[name] = load_object(cfg, name, plain)
+            out[name] = load_sim_object(cfg, name, plain)
         except (ObjectError, ShapeError) as exc:
             log.error("object %s cannot be used: %s", name, exc)
             failed[name] = str(exc)

@@ -10,8 +10,8 @@ from graspexp.config.registry import job_config_from_yaml
 from graspexp.datasets.catalog import DATA_ENV
 from graspexp.planning import plan
 from graspexp.quality import fc_min_mu
-from graspexp.run.objects import load_object, trial_context
-from graspexp.sim.clutter import RoundContext, RoundObject, run_round
+from graspexp.run.objects import load_sim_object, trial_context
+from graspexp.sim.rounds import RoundContext, RoundObject, run_round
 from graspexp.sim.trial import NullRecorder, plain_config, run_trial
 
 POSE_TOLERANCE = 1e-6
@@ -55,7 +55,7 @@ def resimulate(log) -> tuple[bool, str]:
     if log.round_result is not None:
         return _resimulate_round(log, cfg, plain)
     name, trial, seed = meta["object"], int(meta["trial"]), int(meta["trial_seed"])
-    loaded = load_object(cfg, name, plain)
+    loaded = load_sim_object(cfg, name, plain)
     model, shape = loaded.model, loaded.hulls
     capture = _PoseCapture()
     result = run_trial(trial_context(plain, loaded, trial, capture, seed=seed))  # the seed the log recorded
@@ -106,7 +106,7 @@ def _resimulate_round(log, cfg, plain) -> tuple[bool, str]:
     names = str(meta.get("round_objects", "")).split()
     if not names:
         raise ConfigError("the round log's metadata lacks round_objects (the objects drawn for the round)")
-    loaded = [load_object(cfg, name, plain) for name in names]
+    loaded = [load_sim_object(cfg, name, plain) for name in names]
     capture = _PoseCapture()
     ctx = RoundContext(
         plain,

@@ -14,17 +14,17 @@ from collections.abc import Callable, Sequence
 
 from graspexp.report.build import agreement_section, build_report
 from graspexp.report.camera import COLUMNS, LEARNED_COLUMNS, camera_markdown
-from graspexp.report.clutter import (
-    clutter_markdown,
-    find_rounds,
-    registration_markdown,
-    side_by_side_markdown,
-)
 from graspexp.report.collect import collect
 from graspexp.report.gallery import write_gallery
 from graspexp.report.learned import learned_markdown
 from graspexp.report.pages import embed
 from graspexp.report.readings import beside_paper, reading_averages, readings_report
+from graspexp.report.round_tables import (
+    clutter_markdown,
+    find_rounds,
+    registration_markdown,
+    side_by_side_markdown,
+)
 from graspexp.report.study import plot_study, read_sweep_study, study_table
 from graspexp.report.tuning import scored_trial, tuning_markdown
 from graspexp.run.results import Page, PageInput, ResultsError, Sweep
@@ -302,7 +302,7 @@ CLUTTER_SETTINGS = (("pile", "z"), ("packed", "z"))
 
 
 def _clutter(sweep: Sweep) -> Callable[[PageInput], str]:
-    """The clutter table (:func:`graspexp.report.clutter.clutter_markdown`) of ``sweep``'s rounds."""
+    """The clutter table (:func:`graspexp.report.round_tables.clutter_markdown`) of ``sweep``'s rounds."""
     return lambda page: clutter_markdown(find_rounds(page.runs[sweep])) + "\n"
 
 

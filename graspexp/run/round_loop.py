@@ -11,8 +11,8 @@ import numpy as np
 from omegaconf import DictConfig
 from tqdm import tqdm
 
-from graspexp.core.clutter import RoundEnd, RoundResult
 from graspexp.core.files import write_atomic
+from graspexp.core.rounds import RoundEnd, RoundResult
 from graspexp.core.run_layout import (
     ATTEMPTS_CSV,
     ROUNDS_CSV,
@@ -28,7 +28,7 @@ from graspexp.quality import fc_min_mu
 from graspexp.record import read_round, trial_recorder
 from graspexp.record.scene import round_bodies, round_scene
 from graspexp.record.writer import is_write_error
-from graspexp.report.clutter import (
+from graspexp.report.round_tables import (
     attempts_frame,
     clutter_markdown,
     read_rounds,
@@ -38,7 +38,7 @@ from graspexp.run.locks import RunError
 from graspexp.run.objects import LoadedObject
 from graspexp.run.provenance import job_metadata
 from graspexp.run.resume import finished_log
-from graspexp.sim.clutter import RoundContext, RoundObject, run_round
+from graspexp.sim.rounds import RoundContext, RoundObject, run_round
 from graspexp.sim.trial import plain_config
 
 log = logging.getLogger(__name__)

@@ -251,7 +251,7 @@ def _three_in_a_row(x0: float, y: float):
     on ``y``, m) seen by the camera (:func:`graspexp.sim.perceive.perceive_scene`): the plain config, the
     support height, slot -> (model, pose) and the scene's view."""
     from graspexp.run.job_config import make_ready
-    from graspexp.run.objects import load_object
+    from graspexp.run.objects import load_sim_object
     from graspexp.sim.perceive import perceive_scene
     from graspexp.sim.trial import plain_config
 
@@ -259,7 +259,7 @@ def _three_in_a_row(x0: float, y: float):
     make_ready(cfg)
     plain = plain_config(cfg)
     table_z = float(plain.mode.support_height_m)
-    models = [load_object(cfg, name, plain).model for name in ("mug", "banana", "box")]
+    models = [load_sim_object(cfg, name, plain).model for name in ("mug", "banana", "box")]
     objects, x = {}, x0
     for slot, model in enumerate(models):
         lo, hi = model.mesh.bounds

@@ -10,7 +10,7 @@ from helpers.logs import strictly_valid
 from mcap.reader import make_reader
 
 from graspexp.record import TrialRecorder, read_trial
-from graspexp.run.objects import load_object, trial_context
+from graspexp.run.objects import load_sim_object, trial_context
 from graspexp.sim.trial import plain_config, run_trial
 
 pytestmark = pytest.mark.slow
@@ -110,7 +110,7 @@ def collab_log(tmp_path_factory) -> Path:
     """One collab trial that grasps and then removes the support, logged in-process."""
     cfg = compose_cfg("mode=collab")
     plain = plain_config(cfg)
-    loaded = load_object(cfg, "can", plain)
+    loaded = load_sim_object(cfg, "can", plain)
     path = tmp_path_factory.mktemp("collab") / "000.mcap"
     with TrialRecorder(path, {"object": "can"}) as rec:
         run_trial(trial_context(plain, loaded, 0, rec))

@@ -5,8 +5,8 @@ import dataclasses
 
 import pytest
 
-from graspexp.core.clutter import AttemptResult, RoundResult
-from graspexp.report.clutter import attempts_frame, clutter_markdown, clutter_table, rounds_frame
+from graspexp.core.rounds import AttemptResult, RoundResult
+from graspexp.report.round_tables import attempts_frame, clutter_markdown, clutter_table, rounds_frame
 from graspexp.report.stats import wilson_interval
 
 
@@ -81,7 +81,7 @@ def test_every_failed_attempt_of_a_logged_round_gets_a_picture_strip(tmp_path):
 
 
 def test_exact_and_registered_rounds_side_by_side_for_the_planners_both_ran():
-    from graspexp.report.clutter import side_by_side_markdown
+    from graspexp.report.round_tables import side_by_side_markdown
 
     exact = _rounds()
     registered = [dataclasses.replace(r, attempts=r.attempts[:1]) for r in _rounds()[:1]]  # round 0 only

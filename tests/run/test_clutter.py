@@ -9,18 +9,18 @@ from helpers.config import compose_cfg
 
 from graspexp.config import ConfigError
 from graspexp.config.compose import compose_validated
-from graspexp.core.clutter import RoundEnd, RoundResult
 from graspexp.core.geometry import make_pose
+from graspexp.core.rounds import RoundEnd, RoundResult
 from graspexp.core.seeding import round_seed
 from graspexp.planning import plan
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.request import PlanResult
 from graspexp.quality import fc_min_mu
 from graspexp.run.job_config import make_ready
-from graspexp.run.objects import load_object
+from graspexp.run.objects import load_sim_object
 from graspexp.run.round_loop import draw_objects
-from graspexp.sim.clutter import RoundContext, RoundObject, run_round
 from graspexp.sim.clutter_scene import add_clutter_object, clutter_scene
+from graspexp.sim.rounds import RoundContext, RoundObject, run_round
 from graspexp.sim.trial import plain_config
 
 
@@ -30,7 +30,7 @@ def _round(mode: str, objects: list[str], plan_fn=plan, r: int = 0, *overrides: 
     )
     make_ready(cfg)
     plain = plain_config(cfg)
-    loaded = [load_object(cfg, name, plain) for name in objects]
+    loaded = [load_sim_object(cfg, name, plain) for name in objects]
     ctx = RoundContext(
         plain,
         [RoundObject(o.model, o.hulls) for o in loaded],
@@ -228,7 +228,7 @@ def test_objects_of_a_round_sleep_only_with_a_sleep_threshold(threshold):
     cfg = compose_cfg("mode=packed", "dataset=primitives", f"mode.sleep_threshold={threshold}")
     make_ready(cfg)
     plain = plain_config(cfg)
-    box = load_object(cfg, "box", plain)
+    box = load_sim_object(cfg, "box", plain)
     ts = clutter_scene(plain.mode, plain)
     rest = make_pose(np.eye(3), [0.0, 0.0, ts.table_z - float(box.model.points[:, 2].min())])
     add_clutter_object(ts, "object_0", box.model, box.hulls, rest, plain)

@@ -11,8 +11,8 @@ import pandas as pd
 import pytest
 
 from graspexp.config.compose import compose_validated
-from graspexp.core.clutter import AttemptResult
 from graspexp.core.outcome import TrialResult
+from graspexp.core.rounds import AttemptResult
 from graspexp.datasets import select_objects
 from graspexp.report.pages import (
     ATTEMPT_COLUMNS,

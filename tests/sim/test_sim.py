@@ -10,7 +10,7 @@ from graspexp.core.outcome import FailureReason
 from graspexp.planning import plan
 from graspexp.planning.grasp import Grasp
 from graspexp.planning.request import PlanResult
-from graspexp.run.objects import load_object, trial_context
+from graspexp.run.objects import load_sim_object, trial_context
 from graspexp.sim.contacts import GRIPPER_LINKS
 from graspexp.sim.trial import NullRecorder, plain_config, run_trial
 
@@ -33,7 +33,7 @@ class ContactCapture(NullRecorder):
 def _ctx(*overrides, obj="can", trial=0, recorder=None, planner=plan):
     cfg = compose_cfg("dataset=primitives", *overrides)
     plain = plain_config(cfg)
-    return trial_context(plain, load_object(cfg, obj, plain), trial, recorder, plan=planner)
+    return trial_context(plain, load_sim_object(cfg, obj, plain), trial, recorder, plan=planner)
 
 
 # golden trials: fixed seeds whose drops the planner grasps (other seeds may fail for honest reasons)
@@ -135,7 +135,7 @@ def test_a_rocking_object_is_settled_only_after_settle_hold_s(hold_s, rests, dat
         "dataset=ycb", f"dataset.root={data_root}", "mode=bin", "rot=xyz", f"sim.settle_hold_s={hold_s}"
     )
     plain = plain_config(cfg)
-    loaded = load_object(cfg, "021_bleach_cleanser", plain)
+    loaded = load_sim_object(cfg, "021_bleach_cleanser", plain)
     seen = {}
 
     def away(req):

@@ -11,7 +11,7 @@ from helpers.sim import THIN_M, steady_finger_forces
 from omegaconf import OmegaConf
 
 from graspexp.run.job_config import make_ready
-from graspexp.run.objects import load_object, trial_context
+from graspexp.run.objects import load_sim_object, trial_context
 from graspexp.sim.gripper import build_gripper
 from graspexp.sim.trial import plain_config, run_trial
 
@@ -43,7 +43,7 @@ def test_a_can_is_grasped_and_held(urdf, mode, rot, trial):
     cfg = compose_cfg("dataset=primitives", "gripper=urdf", urdf, f"mode={mode}", f"rot={rot}")
     make_ready(cfg)
     plain = plain_config(cfg)
-    res = run_trial(trial_context(plain, load_object(cfg, "can", plain), trial))
+    res = run_trial(trial_context(plain, load_sim_object(cfg, "can", plain), trial))
     assert res.success, res
     assert (
         min(res.finger_force_n) > 0.9 * plain.gripper.grip_force_n

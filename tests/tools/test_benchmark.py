@@ -115,7 +115,7 @@ def test_n_jobs_below_one_is_refused_before_any_work(capsys):
 
 
 def test_the_clutter_modes_run_one_job_per_scene_and_rank_planners_by_dr_then_gsr(tmp_path):
-    from graspexp.core.clutter import AttemptResult, RoundResult
+    from graspexp.core.rounds import AttemptResult, RoundResult
     from graspexp.report.benchmark import clutter_lines, same_rounds
 
     bench = parse_args(["planner=obb", "mode=pile,packed", "rot=xyz", "--noise", ""])

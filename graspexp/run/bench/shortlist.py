@@ -16,7 +16,7 @@ from graspexp.planning import plan
 from graspexp.planning.optimal_plus import pick_shortlisted
 from graspexp.planning.request import PlanResult
 from graspexp.run.job_config import compose_job
-from graspexp.run.objects import load_object, trial_context
+from graspexp.run.objects import load_sim_object, trial_context
 from graspexp.sim.trial import plain_config, run_trial
 
 RULES = ("edge_clearance", "cost")
@@ -44,7 +44,7 @@ def _job(args: tuple[list[str], str, int]) -> list[dict]:
     threadpool_limits(limits=1)
     cfg = compose_config(overrides)
     plain = plain_config(cfg)
-    loaded = load_object(cfg, name, plain)
+    loaded = load_sim_object(cfg, name, plain)
     rows = []
     for i in range(trials):
         seen: dict = {}

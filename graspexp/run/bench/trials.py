@@ -13,7 +13,7 @@ from threadpoolctl import threadpool_limits
 
 from graspexp.config.compose import compose_config
 from graspexp.record import TrialRecorder
-from graspexp.run.objects import load_object, trial_context
+from graspexp.run.objects import load_sim_object, trial_context
 from graspexp.sim.trial import plain_config, run_trial
 
 PHASES = ("build", "settle", "plan", "quality", "execute", "log")
@@ -47,7 +47,7 @@ class _Object:
         cfg = compose_config(overrides)
         self.plain = plain_config(cfg)
         self.name = name
-        self.loaded = load_object(cfg, name, self.plain)
+        self.loaded = load_sim_object(cfg, name, self.plain)
 
     def trial(self, i: int, out: str | None) -> dict:
         """Trial ``i``, logged into folder ``out`` (None: unlogged); wall and CPU time with the timings."""

@@ -13,7 +13,7 @@ logged trials of each object drawn.
 from threadpoolctl import threadpool_limits
 
 from graspexp.config.mode import CLUTTER_MODES
-from graspexp.run.bench.clutter import run_bench
+from graspexp.run.bench.round_latency import run_bench
 from graspexp.tools.cli import compose_checked, positive_int, take_sweep, tool_parser
 
 

@@ -19,9 +19,9 @@ from graspexp.record import TrialRecorder
 from graspexp.record.scene import round_bodies, round_scene
 from graspexp.report.stats import percentiles
 from graspexp.run.job_config import make_ready
-from graspexp.run.objects import load_object, trial_context
+from graspexp.run.objects import load_sim_object, trial_context
 from graspexp.run.round_loop import draw_objects
-from graspexp.sim.clutter import RoundContext, RoundObject, run_round
+from graspexp.sim.rounds import RoundContext, RoundObject, run_round
 from graspexp.sim.scene import cook_shape
 from graspexp.sim.trial import plain_config, run_trial
 
@@ -45,7 +45,7 @@ def clutter_rounds(overrides: list[str], rounds: int, out: Path) -> tuple[list[d
     rounds cooks each once, and the bin trials timed after these rounds find them cooked too."""
     cfg, plain = _job(overrides)
     pool = select_objects(cfg.dataset, cfg.objects)
-    cache = {n: load_object(cfg, n, plain) for n in pool}
+    cache = {n: load_sim_object(cfg, n, plain) for n in pool}
     for obj in cache.values():
         cook_shape(obj.hulls, plain.sim)
     rows, scenes, drawn_all = [], [], []
@@ -85,7 +85,7 @@ def bin_trials(overrides: list[str], names: list[str], out: Path, trials: int) -
     cfg, plain = _job([*overrides, "mode=bin"])
     rows = []
     for name in dict.fromkeys(names):
-        loaded = load_object(cfg, name, plain)
+        loaded = load_sim_object(cfg, name, plain)
         for trial in range(trials):
             t0, c0 = time.perf_counter(), time.thread_time()
             with TrialRecorder(out / "bin" / name / f"{trial:03d}.mcap", {"object": name}) as rec:

@@ -10,7 +10,7 @@ from pathlib import Path
 import pandas as pd
 
 from graspexp.config.mode import CLUTTER_MODES
-from graspexp.core.clutter import RoundEnd, RoundResult
+from graspexp.core.rounds import RoundEnd, RoundResult
 from graspexp.core.run_layout import ATTEMPTS_CSV, ROUNDS_CSV, TRIALS_DIR
 from graspexp.record import CorruptLogError, iter_trial_logs, read_round
 from graspexp.report.stats import percentiles, success_pct

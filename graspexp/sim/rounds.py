@@ -19,9 +19,9 @@ import numpy as np
 
 from graspexp.config import JobConfig
 from graspexp.core.bodies import clutter_body
-from graspexp.core.clutter import AttemptResult, RoundEnd, RoundResult
 from graspexp.core.geometry import matrix_to_quat_wxyz, transform_points
 from graspexp.core.outcome import FailureReason, TrialResult
+from graspexp.core.rounds import AttemptResult, RoundEnd, RoundResult
 from graspexp.core.seeding import derive_seed, rng_for
 from graspexp.datasets.model import ObjectModel
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
