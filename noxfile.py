@@ -15,10 +15,12 @@ nox.options.reuse_existing_virtualenvs = True
 HERE = Path(__file__).parent
 DATA = os.environ.get("GRASPEXP_DATA", str((HERE / ".." / "shared" / "datasets").resolve()))
 ENV = {"GRASPEXP_DATA": DATA, "OMP_NUM_THREADS": "1"}
-LEARNED_PAGES = ("camera", "learned", "clutter_camera")
-"""The results pages whose sweeps run a learned planner (``planner=vgn``): ``nox -s learned`` checks them."""
-CHECKPOINTS = os.environ.get("GRASPEXP_CHECKPOINTS", str((Path(DATA) / ".." / "peers" / "vgn").resolve()))
-"""The published checkpoints the learned planners' tests read (``../shared/peers/vgn``; never copied)."""
+PEERS = (Path(DATA) / ".." / "peers").resolve()
+CHECKPOINTS = os.environ.get(
+    "GRASPEXP_CHECKPOINTS", os.pathsep.join(str(p) for p in sorted(PEERS.glob("*")) if p.is_dir())
+)
+"""The folders of the published checkpoints the learned planners read: every folder of ``../shared/peers``
+(one per planner, searched in turn; never copied)."""
 
 
 @nox.session
@@ -45,16 +47,16 @@ def _install_learned(session: nox.Session) -> bool:
 
 @nox.session
 def learned(session: nox.Session) -> None:
-    """The learned planners' tests (``-m learned``: planner=vgn loads its checkpoint, gives the same outputs
-    every time, plans on a rendered scene) with the optional extra ``learned`` installed, then the
-    fingerprints of the results pages that run them (``results --check --pages camera,learned,clutter_camera``: skipped by
-    the check without the extra); skipped with one line where the extra cannot be installed."""
+    """The learned planners' tests (``-m learned``: e.g. planner=vgn loads its checkpoint, gives the same
+    outputs every time, plans on a rendered scene) with the optional extra ``learned`` installed, then the
+    fingerprints of the results pages that run a learned planner (``results --check --learned-planners``:
+    skipped by the check without the extra); skipped with one line where the extra cannot be installed."""
     session.install("-e", ".[test]", "-c", "constraints.txt")
     if not _install_learned(session):
         session.skip("nox -s learned skipped: the optional extra learned is not available on this machine")
     env = {**ENV, "GRASPEXP_CHECKPOINTS": CHECKPOINTS}
     session.run("pytest", "-m", "learned", "-p", "no:cacheprovider", *session.posargs, env=env)
-    session.run("python", "-m", "graspexp", "results", "--check", "--pages", ",".join(LEARNED_PAGES), env=env)
+    session.run("python", "-m", "graspexp", "results", "--check", "--learned-planners", env=env)
 
 
 @nox.session
@@ -181,19 +183,14 @@ def reproduce(session: nox.Session) -> None:
 
 @nox.session(venv_backend="none")
 def compare(session: nox.Session) -> None:
-    """Six planners x pose noise on a small setting (primitives can/mug/banana, bin, rot z, 3 trials),
-    then ``python -m graspexp compare``. ``nox -s compare -- DIR [overrides...]`` (default outputs/compare);
+    """Six planners x pose noise on a small setting (primitives can/mug/banana, bin, rot z, 3 trials:
+    ``graspexp.run.suites.COMPARE_SUITE``), then ``python -m graspexp compare``. ``nox -s compare -- DIR [overrides...]`` (default outputs/compare);
     resumable."""
     out = session.posargs[0] if session.posargs else "outputs/compare"
     extra = list(session.posargs[1:])
     start = time.perf_counter()
-    session.run(
-        "python", "-m", "graspexp.run.multirun", out,
-        "planner=optimal,optimal_in_area,optimal_plus,antipodal,obb,random",
-        "perception.noise.trans_mm=0,10,20", "perception.noise.rot_deg=0,10",
-        "dataset=primitives", "objects=[can,mug,banana]", "mode=bin", "rot=z", "trials=3", *extra,
-        env=ENV, external=True,
-    )  # fmt: skip
+    suite = session.run("python", "-m", "graspexp.run.suites", "compare", silent=True, env=ENV, external=True)
+    session.run("python", "-m", "graspexp.run.multirun", out, *suite.split(), *extra, env=ENV, external=True)
     session.run("python", "-m", "graspexp", "compare", out, "--out", f"{out}/compare", env=ENV, external=True)
     session.log(f"compare: {time.perf_counter() - start:.0f} s wall")
 

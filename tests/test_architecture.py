@@ -1,7 +1,8 @@
 """The package's import graph: no cycle (type-level imports included), stages import one way
 (config -> datasets/grippers -> perception -> planning -> sim -> record -> report -> run), the tools sit
 above every stage, the package's top level holds only stage packages, the base package and the entry point,
-and the config stage reads no mesh or URDF file (the grippers stage does)."""
+the config stage reads no mesh or URDF file (the grippers stage does), and only the perception stage renders
+depth, adds its noise, registers and fuses."""
 
 import ast
 import subprocess
@@ -170,3 +171,38 @@ def test_the_config_stage_opens_no_mesh_or_urdf_file():
                 f"{path.relative_to(PACKAGE)} imports {n}" for n in names if n.split(".")[0] in FILE_READERS
             ]
     assert not wrong, "\n".join(wrong)
+
+
+PERCEPTION_LIBRARIES = frozenset({"embreex", "open3d"})
+"""The ray caster and the registration/fusion library: only ``graspexp/perception/`` imports them."""
+PERCEPTION_API = frozenset(
+    {
+        "graspexp.perception",  # the types a planner reads: Observation, CameraView
+        "graspexp.perception.observation",
+        "graspexp.perception.scene_view",  # the planner's view of a scene: what the simulator asks for
+        "graspexp.perception.tsdf",  # the views fused for a volumetric planner
+    }
+)
+"""What a later stage may import of perception; rendering (``camera``), depth noise (``depth_noise``),
+``observe``/``estimate_pose`` and registration are its own. The run stage's benches and the tools sit above
+every stage and may call any of it."""
+
+
+def test_perception_is_one_stage():
+    """Nothing outside ``graspexp/perception/`` renders depth, adds depth noise, registers or fuses: no other
+    module imports the libraries that do it, nor a perception module beyond :data:`PERCEPTION_API`."""
+    wrong = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        module = _module_name(path)
+        if module.startswith("graspexp.perception"):
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else []
+            names += [node.module] if isinstance(node, ast.ImportFrom) and node.module else []
+            wrong += [f"{module} imports {n}" for n in names if n.split(".")[0] in PERCEPTION_LIBRARIES]
+    graph = _graph()
+    for module, deps in graph.items():
+        if _kind(module) != "tool" and not module.startswith(("graspexp.perception", "graspexp.run.bench")):
+            inside = {d for d in deps if d.startswith("graspexp.perception")} - PERCEPTION_API
+            wrong += [f"{module} imports {d}" for d in sorted(inside)]
+    assert not wrong, "perception outside graspexp/perception/:\n" + "\n".join(wrong)

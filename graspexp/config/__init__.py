@@ -21,7 +21,7 @@ from graspexp.config.planner import (
     PlannerConfig,
     RandomConfig,
 )
-from graspexp.config.plugins import PlannerPlugin, PluginError
+from graspexp.config.plugins import Learned, PlannerPlugin, PluginError
 from graspexp.config.registry import register_configs
 from graspexp.config.rot import RotConfig
 from graspexp.config.sim import SimConfig
@@ -33,6 +33,7 @@ __all__ = [
     "BASE_CONSTRAINTS",
     "AntipodalConfig",
     "CameraConfig",
+    "Learned",
     "ObbConfig",
     "OptimalConfig",
     "OptimalPlusConfig",

@@ -6,6 +6,7 @@ import dataclasses
 from omegaconf import DictConfig, OmegaConf
 
 from graspexp.config.constraints import BEFORE
+from graspexp.config.mode import CLUTTER_KEYS, LEGACY_SCENES, ClutterModeConfig
 from graspexp.core.userinput import load_user_yaml
 
 RESULT_NEUTRAL_KEYS = (
@@ -84,4 +85,21 @@ def config_differences(recorded_yaml: str, cfg: DictConfig) -> dict[str, tuple[o
         if not _neutral(k)
         and old.get(k, absent) != new.get(k, absent)
         and not (k not in old and k in new and new[k] == _value_before(cfg, k))
+        and not _moved(k, old, new)
     }
+
+
+def _moved(key: str, old: dict[str, object], new: dict[str, object]) -> bool:
+    """Whether ``key`` differs only because the clutter keys moved into their own schema
+    (:class:`graspexp.config.mode.ClutterModeConfig`): a single-object mode's log that recorded one at its
+    default, or a clutter log without ``mode.scene`` whose mode is named after its scene type."""
+    group, _, leaf = key.partition(".")
+    if group != "mode":
+        return False
+    if leaf == "scene" and key not in old:
+        return old.get("mode.name") in LEGACY_SCENES and new[key] == old["mode.name"]
+    field = next((f for f in dataclasses.fields(ClutterModeConfig) if f.name == leaf), None)
+    if leaf not in CLUTTER_KEYS or key in new or field is None:
+        return False
+    default = field.default_factory() if field.default_factory is not dataclasses.MISSING else field.default
+    return old[key] == default

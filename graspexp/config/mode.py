@@ -1,19 +1,19 @@
 """Schema of the ``mode`` config group: collaborative hand-over or bin picking (paper IV-A, IV-C), and
 clutter removal (``pile``, ``packed``: VGN, Breyer et al. CoRL 2020; GIGA, Jiang et al. RSS 2021)."""
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 from omegaconf import MISSING
 
-from graspexp.config.constraints import BOOL, Interval, Options, Vector
+from graspexp.config.constraints import BOOL, Interval, Options, Pattern, Vector
 
 
 @dataclass
 class ModeConfig:
     name: str = MISSING
     """``collab`` (Eq. 1; box removed after the grasp) or ``bin`` (Eq. 2-3; table, pull back): one object per
-    trial; ``pile`` or ``packed``: a clutter-removal round of :attr:`objects_per_round` objects on the table,
-    grasped one at a time (Eq. 2-3, pull back and lift as in ``bin``; :mod:`graspexp.sim.rounds`)."""
+    trial; a clutter mode (:class:`ClutterModeConfig`: ``pile``, ``packed``) names its rounds' log folder
+    (``trials/<name>/``)."""
     support_height_m: float = 0.10
     """Height of the support's top face above the ground plane, m (the plane z = h)."""
     support_half_size_m: list[float] = MISSING
@@ -32,14 +32,26 @@ class ModeConfig:
     """Bin mode: extra lift along world +Z after the pull back, m."""
     hold_s: float = 2.0
     """Time the grasp must hold at the end, s."""
+
+
+@dataclass
+class ClutterModeConfig(ModeConfig):
+    """A clutter-removal mode (``mode=pile``, ``mode=packed``): a round of :attr:`objects_per_round` objects on
+    the table, grasped one at a time (:mod:`graspexp.sim.rounds`). Its keys beside :class:`ModeConfig`'s: the
+    scene type and the round's protocol."""
+
+    scene: str = MISSING
+    """How the round's objects come onto the table: the name of a registered scene type
+    (:mod:`graspexp.sim.scene_types`: ``pile``, objects dropped into a box that is lifted away; ``packed``,
+    objects stood upright side by side). A new scene type is a class there and a preset here."""
     objects_per_round: int = 5
-    """``pile``/``packed``: objects drawn from the pool (``objects``, else the dataset's list) per round, seeded
+    """Objects drawn from the pool (``objects``, else the dataset's list) per round, seeded
     per round; without replacement when the pool holds enough, else with. 5: VGN's and GIGA's rounds."""
     max_consecutive_failures: int = 2
-    """``pile``/``packed``: the round ends after this many failed grasp attempts in a row (VGN's
+    """The round ends after this many failed grasp attempts in a row (VGN's
     ``MAX_CONSECUTIVE_FAILURES = 2``, ethz-asl/vgn src/vgn/experiments/clutter_removal.py)."""
     workspace_half_size_m: list[float] = field(default_factory=lambda: [0.15, 0.15])
-    """``pile``/``packed``: half extents [x, y] of the square the objects are placed in, centred on the table,
+    """Half extents [x, y] of the square the objects are placed in, centred on the table,
     m. An object whose centre of mass is outside it (or off the table) once the scene has settled is taken
     away before the first attempt and not counted as placed. 0.3 m: VGN's workspace (``size`` 0.3 m, its
     ``remove_objects_outside_roi``)."""
@@ -56,7 +68,7 @@ class ModeConfig:
     """``packed``: least gap between the footprints (each model's x-y bounding rectangle, turned by its yaw)
     of two objects placed upright, m: side by side, not touching."""
     pick_order: str = "lowest_cost"
-    """``pile``/``packed``: which object to grasp next. ``lowest_cost``: plan every object on the table (the
+    """Which object to grasp next. ``lowest_cost``: plan every object on the table (the
     planner sees the others as obstacles) and execute the grasp of least cost (the paper's Eq. 2-3 choice
     extended over the objects: the same rule that picks a path picks the object); ``top_most``: plan the
     objects from the highest top down and execute the first grasp found (a heap is cleared from the top,
@@ -64,7 +76,7 @@ class ModeConfig:
     the camera (``vgn``, ``antipodal_view``) follow the same rule: each object in turn is the observation's
     ``target_id`` (vgn: the detections that hold it, cost 1 - quality)."""
     sleep_threshold: float = 0.0
-    """``pile``/``packed``: PhysX sleep threshold of the round's objects, m^2/s^2: a body whose mass-normalised
+    """PhysX sleep threshold of the round's objects, m^2/s^2: a body whose mass-normalised
     kinetic energy stays below it for PhysX's wake counter (0.4 s) is put to sleep, skipped by the solver
     until an awake body touches it or one it rests on is removed. 0: never, as the bodies of every trial
     (``sim`` sets 0 for all). 0.005, PhysX's default, lets the untouched objects of a heap sleep through an
@@ -75,14 +87,14 @@ class ModeConfig:
     physics."""
 
 
-CLUTTER_MODES = ("pile", "packed")
-"""The modes whose trials are clutter-removal rounds (:mod:`graspexp.sim.rounds`)."""
 PICK_ORDERS = ("lowest_cost", "top_most")
 """The values of ``mode.pick_order``."""
+NAME = [Pattern(r"[A-Za-z0-9][A-Za-z0-9_.-]*", "a name of letters, digits, '_', '.' and '-'")]
+"""A clutter mode's name: its rounds' log folder ``trials/<name>/``."""
 
 
 CONSTRAINTS = {
-    "name": [Options(("collab", "bin", *CLUTTER_MODES))],
+    "name": [Options(("collab", "bin"))],
     "support_height_m": [Interval(0, 2, "right", "m")],
     "support_half_size_m": [Vector(2, Interval(0, 5, "right", "m"))],
     "support_collides_with_gripper": BOOL,
@@ -90,6 +102,12 @@ CONSTRAINTS = {
     "pull_back_m": [Interval(0, 2, unit="m")],
     "lift_m": [Interval(0, 2, unit="m")],
     "hold_s": [Interval(0, 60, "right", "s")],
+}
+"""Allowed values of every key of :class:`ModeConfig` (see :mod:`graspexp.config.constraints`)."""
+CLUTTER_CONSTRAINTS = {
+    **CONSTRAINTS,
+    "name": NAME,
+    "scene": NAME,
     "objects_per_round": [Interval(1, 50, integer=True)],
     "max_consecutive_failures": [Interval(1, 100, integer=True)],
     "workspace_half_size_m": [Vector(2, Interval(0, 5, "right", "m"))],
@@ -100,4 +118,17 @@ CONSTRAINTS = {
     "pick_order": [Options(PICK_ORDERS)],
     "sleep_threshold": [Interval(0, 1, unit="m^2/s^2")],
 }
-"""Allowed values of every key (see :mod:`graspexp.config.constraints`)."""
+"""Allowed values of every key of :class:`ClutterModeConfig`; ``scene`` names a registered scene type, checked
+when the job starts (:func:`graspexp.sim.scene_types.scene_type`)."""
+
+
+CLUTTER_KEYS = frozenset(f.name for f in fields(ClutterModeConfig)) - {f.name for f in fields(ModeConfig)}
+"""The keys only a clutter mode has (every mode had them before :class:`ClutterModeConfig` existed)."""
+LEGACY_SCENES = ("pile", "packed")
+"""The clutter modes of logs written before ``mode.scene``: each named after its scene type."""
+
+
+def is_clutter(mode: object) -> bool:
+    """Whether a mode config (a composed node or its dataclass) is a clutter-removal mode: its schema is
+    :class:`ClutterModeConfig` (it has a ``scene``)."""
+    return getattr(mode, "scene", None) is not None

@@ -1,6 +1,7 @@
 """Schema of ``perception``: what the planner is told about the object (the exact pose, or a pose
 registered from a simulated depth camera) and the camera itself (``perception/camera`` group, preset
-``d435``), its depth noise model and the registration.
+``d435``), its depth noise model and the registration. A camera preset sets ``perception.camera`` and,
+when the sensor has its own, ``perception.depth_noise``: a new camera is one YAML file.
 
 The camera is a CPU ray caster (trimesh + Embree through the ``embreex`` package): SAPIEN's own camera
 needs a Vulkan device, which the CPU-only machines this project runs on lack (Debian 12's Mesa lavapipe
@@ -17,6 +18,9 @@ SOURCES = ("truth", "depth")
 """Values of ``perception.source``."""
 PRIORS = ("noisy_truth", "none")
 """Values of ``perception.registration.prior``."""
+DEPTH_NOISE_MODELS = ("nguyen",)
+"""Values of ``perception.depth_noise.model``: the noise models the perception stage implements, each a
+function registered under its name (:data:`graspexp.perception.depth_noise.NOISE_MODELS`)."""
 CAMERA_EXTRA = "pip install 'graspexp[camera]'"
 """The command that installs the camera's packages (embreex, open3d-cpu)."""
 CAMERA_MODULES = {"embreex": "embreex", "open3d": "open3d-cpu"}
@@ -86,7 +90,10 @@ class CameraConfig:
 
 @dataclass
 class DepthNoiseConfig:
-    """Depth noise of Nguyen, Izadi & Lovell, "Modeling Kinect Sensor Noise for Improved 3D
+    """The camera's depth noise: a model by name (``model``) and its coefficients. A camera preset
+    (``conf/perception/camera/<name>.yaml``) may carry its own under ``depth_noise:``.
+
+    ``nguyen``: Nguyen, Izadi & Lovell, "Modeling Kinect Sensor Noise for Improved 3D
     Reconstruction and Tracking", 3DIMPVT 2012, Eq. (1)-(2): axial
     ``sigma_z(z, theta) = a + b (z - z0)^2 + c / sqrt(z) * theta^2 / (pi/2 - theta)^2`` m and lateral
     ``sigma_L(theta) = l0 + l1 * theta / (pi/2 - theta)`` px (z depth in m, theta the angle between the ray
@@ -96,6 +103,9 @@ class DepthNoiseConfig:
 
     enabled: bool = True
     """False: exact depth (no noise, no missing pixels but out-of-range ones)."""
+    model: str = "nguyen"
+    """The noise model (:mod:`graspexp.perception.depth_noise`): ``nguyen``, Nguyen et al. 2012's axial and
+    lateral noise with the coefficients below."""
     axial_a_m: float = 0.0012
     """a, m (Nguyen et al. 2012)."""
     axial_b_m: float = 0.0019
@@ -151,8 +161,10 @@ class PerceptionConfig:
     pose registered from the simulated depth camera's view."""
     noise: PoseNoiseConfig = field(default_factory=PoseNoiseConfig)
     camera: CameraConfig = field(default_factory=CameraConfig)
-    """The camera: a ``perception/camera`` option (``d435``)."""
+    """The camera: a ``perception/camera`` option (``d435``), which sets ``camera`` and may set
+    ``depth_noise``."""
     depth_noise: DepthNoiseConfig = field(default_factory=DepthNoiseConfig)
+    """The camera's depth noise: its preset's, else the schema's defaults (the ``nguyen`` model)."""
     registration: RegistrationConfig = field(default_factory=RegistrationConfig)
 
 
@@ -181,6 +193,7 @@ CAMERA_CONSTRAINTS = {
 }
 DEPTH_NOISE_CONSTRAINTS = {
     "enabled": BOOL,
+    "model": [Options(DEPTH_NOISE_MODELS)],
     "axial_a_m": [Interval(0, 1, unit="m")],
     "axial_b_m": [Interval(0, 1)],
     "axial_z0_m": [Interval(0, 10, unit="m")],

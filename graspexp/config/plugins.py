@@ -6,6 +6,12 @@ register the same way, in graspexp's own ``pyproject.toml``. A plugin's config s
 travel with it: they are stored in Hydra's ConfigStore by :func:`graspexp.config.registry.register_configs`
 and checked by :func:`graspexp.config.validate`. This module imports no planner code: ``plan`` is resolved
 by :mod:`graspexp.planning.registry` when a planner runs.
+
+A learned planner (a network run from published weights) declares itself with :class:`Learned`
+(``PlannerPlugin.learned``): the gripper it was trained for, its checkpoints, the optional extra it needs and
+its column label. The shared code iterates over :func:`learned_planners` (the results pages' learned sweeps
+and columns, ``bench.learned``, ``download_checkpoint``, ``nox -s learned``), so a new learned planner is its
+plugin module, its entry point and its config preset, and no edit elsewhere.
 """
 
 from __future__ import annotations
@@ -18,6 +24,7 @@ from importlib.metadata import EntryPoint, entry_points
 from typing import Any
 
 from graspexp.config.planner.base import PlannerConfig
+from graspexp.core.checkpoints import Checkpoint
 
 ENTRY_POINT_GROUP = "graspexp.planners"
 
@@ -25,6 +32,31 @@ ENTRY_POINT_GROUP = "graspexp.planners"
 class PluginError(RuntimeError):
     """A planner plugin that cannot be used (unknown name, failed import, malformed object); one line
     naming the planner, its package and the fix."""
+
+
+@dataclass(frozen=True)
+class Learned:
+    """What a learned planner brings beside its plan function (:attr:`PlannerPlugin.learned`).
+
+    The results pages run every learned planner on the gripper it was trained for (the camera page's
+    column, the learned page, the camera clutter page) and on the paper's gripper (a transfer, the learned
+    page); ``python -m graspexp bench.learned`` times its plans (its ``plan`` logs the CPU seconds of its
+    two steps in ``Grasp.extras``: ``fuse_cpu_s``, ``infer_cpu_s``).
+    """
+
+    gripper: str
+    """The gripper it was trained for (``gripper=NAME``): the pages and ``bench.learned`` run it with it."""
+    checkpoints: tuple[Checkpoint, ...] = ()
+    """The published checkpoints it loads: ``python -m graspexp download_checkpoint NAME`` fetches each,
+    from any of the folders of ``$GRASPEXP_CHECKPOINTS`` (:mod:`graspexp.core.checkpoints`)."""
+    extra: str = "learned"
+    """The optional extra of its package that installs what it imports (torch, Open3D, ...)."""
+    column: str = ""
+    """Its column label on the camera page (:func:`column_label`); '' for ``NAME, gripper=G, camera views``."""
+
+    def column_label(self, name: str) -> str:
+        """The camera page's column label of the planner ``name``."""
+        return self.column or f"{name}, gripper={self.gripper}, camera views"
 
 
 @dataclass(frozen=True)
@@ -41,9 +73,14 @@ class PlannerPlugin:
     needs_observation : the planner reads the depth camera's output (``PlanRequest.observation``): the
         trial renders the camera for it even with ``perception.source=truth`` (the camera extra must be
         installed).
+    plan_scene : optional, the planner for a whole scene at once, ``SceneRequest -> SceneResult``
+        (:mod:`graspexp.planning.scene`: one fusion and one forward pass for every object of a clutter
+        round), or its import path ``"module:function"``; None: the round plans each object with ``plan``.
     unavailable : optional ``() -> str``: '' when the planner can run on this machine, else one line
         naming what is missing and the command that brings it (an optional extra, a checkpoint); called
         when a config selects the planner, so the run stops before its first trial.
+    learned : for a learned planner (a network from published weights), what it brings (:class:`Learned`);
+        None for any other planner.
     """
 
     plan: Callable[..., Any] | str
@@ -51,7 +88,9 @@ class PlannerPlugin:
     constraints: Mapping[str, list]
     version: str = ""
     needs_observation: bool = False
+    plan_scene: Callable[..., Any] | str | None = None
     unavailable: Callable[[], str] | None = None
+    learned: Learned | None = None
 
 
 @dataclass(frozen=True)
@@ -115,6 +154,13 @@ def _load(ep: EntryPoint) -> LoadedPlanner:
         )
     if not (callable(plugin.plan) or (isinstance(plugin.plan, str) and ":" in plugin.plan)):
         raise PluginError(f"{where}: plan={plugin.plan!r} is neither a function nor 'module:function'")
+    scene = plugin.plan_scene
+    if not (scene is None or callable(scene) or (isinstance(scene, str) and ":" in scene)):
+        raise PluginError(f"{where}: plan_scene={scene!r} is neither None, a function nor 'module:function'")
+    if plugin.learned is not None and not isinstance(plugin.learned, Learned):
+        raise PluginError(
+            f"{where}: learned={plugin.learned!r} is neither None nor a graspexp.config.Learned"
+        )
     dist = getattr(ep, "dist", None)
     return LoadedPlanner(
         ep.name, _package(ep), ep.value, plugin, dist.version if dist is not None else "unknown"
@@ -151,3 +197,13 @@ def get_plugin(name: str) -> LoadedPlanner:
     if isinstance(found, PluginError):
         raise found
     return found
+
+
+def learned_planners() -> dict[str, Learned]:
+    """Every installed planner that declares itself learned (:attr:`PlannerPlugin.learned`), by name in
+    name order; a plugin that fails to load is left out (selecting it says why)."""
+    return {
+        name: found.plugin.learned
+        for name, found in sorted(load_planners().items())
+        if isinstance(found, LoadedPlanner) and found.plugin.learned is not None
+    }

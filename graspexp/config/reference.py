@@ -22,7 +22,7 @@ import yaml
 from graspexp.config.constraints import BEFORE, describe
 from graspexp.config.job import JobConfig
 from graspexp.config.plugins import LoadedPlanner, load_planners
-from graspexp.config.registry import CONF_DIR, SCHEMAS, group_options
+from graspexp.config.registry import CONF_DIR, SCHEMAS, SUBSCHEMAS, group_options
 from graspexp.config.validate import NOT_CONFIG, SCHEMA_CONSTRAINTS
 
 UNIT_SUFFIXES = (
@@ -231,6 +231,16 @@ def render() -> str:
             "",
             *_options(group, keys, group_options(group)),
         ]
+        for sub in (sub for g, sub in SUBSCHEMAS.values() if g == group):
+            own = {k.dotted for k in keys}
+            out += [
+                "",
+                f"### `{group}` options with `{sub.__module__}.{sub.__qualname__}`",
+                "",
+                _md(" ".join((sub.__doc__ or "").split())),
+                "",
+                *_table([k for k in schema_keys(sub, f"{group}.") if k.dotted not in own]),
+            ]
     out += [
         "",
         "## `planner`",

@@ -10,8 +10,8 @@ from graspexp.config.dataset import DatasetConfig
 from graspexp.config.errors import ConfigError
 from graspexp.config.gripper import GripperConfig
 from graspexp.config.job import JobConfig
-from graspexp.config.mode import ModeConfig
-from graspexp.config.perception import CameraConfig
+from graspexp.config.mode import CLUTTER_KEYS, LEGACY_SCENES, ClutterModeConfig, ModeConfig
+from graspexp.config.perception import CameraConfig, DepthNoiseConfig
 from graspexp.config.plugins import LoadedPlanner, PluginError, get_plugin, load_planners
 from graspexp.config.rot import RotConfig
 from graspexp.config.sim import SimConfig
@@ -25,9 +25,15 @@ SCHEMAS = {
     "sim": SimConfig,
 }
 """The schema of each group with one schema; the ``planner`` group has one per planner (its plugin's)."""
-NESTED_SCHEMAS = {"camera": CameraConfig}
-"""Schemas of the groups nested under a key (``perception/camera``, its options at ``perception.camera``),
-stored as ``schema_<name>``."""
+SUBSCHEMAS = {"clutter_mode": ("mode", ClutterModeConfig)}
+"""Schemas of a group's options that extend the group's schema with keys of their own, stored as
+``schema_<name>`` (name -> (group, schema)): the clutter modes' (``conf/mode/pile.yaml`` lists
+``/schema_clutter_mode@_here_``)."""
+NESTED_SCHEMAS = {"camera": CameraConfig, "depth_noise": DepthNoiseConfig}
+"""Schemas of the keys a nested group's options set, stored as ``schema_<key>``: a ``perception/camera``
+option (``# @package perception``) sets ``perception.camera`` and, for a sensor with its own noise model,
+``perception.depth_noise``; its defaults list names both schemas (``/schema_camera@camera``,
+``/schema_depth_noise@depth_noise``)."""
 
 
 def _conf_dir() -> Path:
@@ -75,6 +81,8 @@ def register_configs() -> None:
         cs.store(name=schema_name(group), node=schema)
     for name, schema in NESTED_SCHEMAS.items():
         cs.store(name=schema_name(name), node=schema)
+    for name, (_, schema) in SUBSCHEMAS.items():
+        cs.store(name=schema_name(name), node=schema)
     presets = _yaml_options("planner")
     for name, found in load_planners().items():
         if isinstance(found, LoadedPlanner):
@@ -84,12 +92,28 @@ def register_configs() -> None:
                 cs.store(group="planner", name=name, node=schema(name=name))
 
 
+def _recorded_mode(mode: DictConfig) -> DictConfig:
+    """A recorded ``mode`` node typed by its schema: :class:`ClutterModeConfig` when it names a scene type (a
+    log written before ``mode.scene`` existed: a ``pile`` or ``packed`` mode, its scene type of that name),
+    else :class:`ModeConfig` (such an older log recorded the clutter keys for every mode: dropped)."""
+    if "scene" not in mode and mode.get("name") in LEGACY_SCENES:
+        mode.scene = mode.name
+    if "scene" in mode:
+        return OmegaConf.merge(OmegaConf.structured(ClutterModeConfig), mode)
+    return OmegaConf.merge(
+        OmegaConf.structured(ModeConfig), {k: v for k, v in mode.items() if k not in CLUTTER_KEYS}
+    )
+
+
 def job_config_from_yaml(text: str) -> DictConfig:
     """A job config recorded as YAML (e.g. a trial log's ``config_yaml``) typed again by its schemas, the
-    ``planner`` node by the schema of the planner it names (:class:`PluginError` if none is installed)."""
+    ``planner`` node by the schema of the planner it names (:class:`PluginError` if none is installed), a
+    clutter mode's by :class:`ClutterModeConfig` (a log written before ``mode.scene`` existed: the scene type
+    its mode was named for)."""
     try:
         data = OmegaConf.create(text)
         planner = OmegaConf.structured(get_plugin(data.planner.name).plugin.config)
+        data.mode = _recorded_mode(data.mode)
         cfg = OmegaConf.merge(OmegaConf.structured(JobConfig), data)
         cfg.planner = OmegaConf.merge(planner, data.planner)
     except PluginError:

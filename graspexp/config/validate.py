@@ -29,6 +29,7 @@ SCHEMA_CONSTRAINTS: dict[type, dict[str, list]] = {
     dataset.DatasetConfig: dataset.CONSTRAINTS,
     gripper.GripperConfig: gripper.CONSTRAINTS,
     mode.ModeConfig: mode.CONSTRAINTS,
+    mode.ClutterModeConfig: mode.CLUTTER_CONSTRAINTS,
     cost.CostConfig: cost.CONSTRAINTS,
     rot.RotConfig: rot.CONSTRAINTS,
     sim.SimConfig: sim.CONSTRAINTS,
@@ -77,11 +78,18 @@ def _check_node(node: DictConfig, schema: type, prefix: str, constraints: dict |
             _check_planner(value)
             continue
         if dataclasses.is_dataclass(field.type):
-            _check_node(value, field.type, dotted + ".")
+            _check_node(value, _node_schema(value, field.type), dotted + ".")
             continue
         plain = OmegaConf.to_container(value) if OmegaConf.is_config(value) else value
         if not accepts(constraints[name], plain):
             raise ConfigError(f"{dotted}={plain!r} is invalid: expected {describe(constraints[name])}")
+
+
+def _node_schema(node: DictConfig, declared: type) -> type:
+    """The schema a node was composed from: a subclass of the declared one (a clutter mode's
+    :class:`graspexp.config.mode.ClutterModeConfig` under ``mode``), else the declared one."""
+    actual = OmegaConf.get_type(node)
+    return actual if isinstance(actual, type) and issubclass(actual, declared) else declared
 
 
 def _check_planner(node: DictConfig) -> None:

@@ -2,7 +2,8 @@
 it lies on this machine. Pure standard library: the config stage checks that a checkpoint is there, the
 planner verifies it before loading, the ``download_checkpoint`` tool fetches it.
 
-A checkpoint lies in ``$GRASPEXP_CHECKPOINTS`` (a folder), else ``~/.cache/graspexp/checkpoints``.
+A checkpoint lies in ``$GRASPEXP_CHECKPOINTS`` (a folder, or several joined by ``os.pathsep`` and searched in
+order: one per learned planner), else ``~/.cache/graspexp/checkpoints``.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 CHECKPOINTS_ENV = "GRASPEXP_CHECKPOINTS"
-"""Environment variable naming the folder that holds the checkpoints."""
+"""Environment variable naming the folder that holds the checkpoints (several: joined by ``os.pathsep``)."""
 
 
 @dataclass(frozen=True)
@@ -50,17 +51,24 @@ VGN = Checkpoint(
 )
 
 CHECKPOINTS: dict[str, Checkpoint] = {c.name: c for c in (VGN,)}
-"""Every checkpoint by name."""
+"""graspexp's own checkpoints by name (a learned planner's plugin names the ones it loads:
+``graspexp.config.plugins.Learned.checkpoints``)."""
 
 
 class CheckpointError(RuntimeError):
     """A checkpoint that is missing or differs from its published hash; one line naming the fix."""
 
 
+def checkpoint_dirs() -> list[Path]:
+    """The folders of ``$GRASPEXP_CHECKPOINTS`` (joined by ``os.pathsep``), in order, else
+    ``~/.cache/graspexp/checkpoints``."""
+    env = [d for d in os.environ.get(CHECKPOINTS_ENV, "").split(os.pathsep) if d]
+    return [Path(d).expanduser() for d in env] or [Path.home() / ".cache" / "graspexp" / "checkpoints"]
+
+
 def checkpoint_dir() -> Path:
-    """``$GRASPEXP_CHECKPOINTS``, else ``~/.cache/graspexp/checkpoints``."""
-    env = os.environ.get(CHECKPOINTS_ENV)
-    return Path(env).expanduser() if env else Path.home() / ".cache" / "graspexp" / "checkpoints"
+    """The first folder of :func:`checkpoint_dirs`: where a checkpoint is downloaded to."""
+    return checkpoint_dirs()[0]
 
 
 def download_command(ckpt: Checkpoint) -> str:
@@ -69,8 +77,10 @@ def download_command(ckpt: Checkpoint) -> str:
 
 
 def checkpoint_path(ckpt: Checkpoint) -> Path:
-    """Where ``ckpt`` lies (whether or not it is there)."""
-    return checkpoint_dir() / ckpt.filename
+    """Where ``ckpt`` lies: in the first folder of :func:`checkpoint_dirs` that holds its file, else (not
+    there) in the first folder."""
+    paths = [d / ckpt.filename for d in checkpoint_dirs()]
+    return next((p for p in paths if p.is_file()), paths[0])
 
 
 def missing_reason(ckpt: Checkpoint) -> str:

@@ -75,7 +75,8 @@ def yaw_rotation(angle_rad: float) -> np.ndarray:
 def pose_error(rng: np.random.Generator, trans_mm: float, rot_deg: float) -> tuple[np.ndarray, np.ndarray]:
     """One draw of the pose estimator's error: (3, 3) rotation about a random axis by a Gaussian angle
     (std ``rot_deg``) and (3,) Gaussian translation (std ``trans_mm`` per axis), m. The one error model of
-    the simulated perception (:func:`graspexp.sim.perceive.perceived_pose`), of the registration bench
-    (:mod:`graspexp.perception.accuracy`) and of the planner's noise check (:mod:`graspexp.planning.stability`)."""
+    the simulated perception (:func:`graspexp.perception.scene_view.perceived_pose`), of the registration
+    bench (:mod:`graspexp.run.bench.registration`) and of the planner's noise check
+    (:mod:`graspexp.planning.stability`)."""
     rotation = axis_angle_matrix(rng.normal(size=3), np.deg2rad(rng.normal(0.0, rot_deg)))
     return rotation, rng.normal(0.0, trans_mm, size=3) / 1000.0

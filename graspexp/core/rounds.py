@@ -92,8 +92,8 @@ class RoundResult:
     """Slots removed by a successful grasp."""
     end: str
     """A :class:`RoundEnd` value."""
-    attempts: list[dict] = field(default_factory=list)
-    """Every :class:`AttemptResult` of the round, as dicts."""
+    attempts: list[AttemptResult] = field(default_factory=list)
+    """Every attempt of the round, in order."""
     error: str = ""
     wall_s: float = 0.0
     cpu_s: float = 0.0
@@ -106,9 +106,6 @@ class RoundResult:
     @property
     def n_removed(self) -> int:
         return len(self.removed)
-
-    def attempt_rows(self) -> list[AttemptResult]:
-        return [AttemptResult(**a) for a in self.attempts]
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -124,9 +121,13 @@ class RoundResult:
         if d["end"] not in {e.value for e in RoundEnd}:
             raise ValueError(f"round result end={d['end']!r} is not one of {[e.value for e in RoundEnd]}")
         known = set(cls.__dataclass_fields__)
-        out = cls(**{k: v for k, v in d.items() if k in known})
+        fields = {k: v for k, v in d.items() if k in known}
+        if not isinstance(fields["attempts"], list) or not all(
+            isinstance(a, dict) for a in fields["attempts"]
+        ):
+            raise ValueError("round result's attempts are not a list of mappings")
         try:
-            out.attempt_rows()
+            fields["attempts"] = [AttemptResult(**a) for a in fields["attempts"]]
         except TypeError as exc:
             raise ValueError(f"round result has a malformed attempt ({exc})") from None
-        return out
+        return cls(**fields)

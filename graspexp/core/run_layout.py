@@ -54,6 +54,13 @@ def trial_log_path(run_dir: Path | str, object_name: str, trial: int) -> Path:
     return trials_dir(run_dir) / check_object_name(object_name) / f"{trial:03d}.mcap"
 
 
+def round_log_path(run_dir: Path | str, mode_name: str, round_index: int) -> Path:
+    """Where round ``round_index`` of a clutter job is logged in ``run_dir``: ``trials/<mode.name>/NNN.mcap``
+    (one folder per clutter mode, beside the objects' folders of single-object runs; :class:`UserInputError`
+    for a name that would leave ``trials/``)."""
+    return trials_dir(run_dir) / check_object_name(mode_name) / f"{round_index:03d}.mcap"
+
+
 class LinkedRunPathError(OSError):
     """A folder or file of a run directory is a symbolic link (someone else's file would be written); the
     message is one line naming it."""

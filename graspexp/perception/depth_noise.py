@@ -1,17 +1,39 @@
-"""The depth noise model of Nguyen, Izadi & Lovell, "Modeling Kinect Sensor Noise for Improved 3D
-Reconstruction and Tracking" (3DIMPVT 2012), applied to an exact ray-cast frame, plus missing pixels at
-grazing angles and depth edges. Coefficients and thresholds: :class:`graspexp.config.perception.DepthNoiseConfig`.
+"""Depth noise models, applied to an exact ray-cast frame: :func:`noisy_depth` dispatches by name
+(``perception.depth_noise.model``) to a function of :data:`NOISE_MODELS`. A new model is one function
+registered with :func:`noise_model` and its name in :data:`graspexp.config.perception.DEPTH_NOISE_MODELS`
+(and its coefficients, if new, in :class:`graspexp.config.perception.DepthNoiseConfig`).
 
-Order: (1) pixels beyond ``max_incidence_deg`` lose their return; (2) lateral noise: each pixel takes the
-return (depth, id, angle) of the pixel offset by a Gaussian (du, dv) of std ``sigma_L(theta)`` px, rounded;
-(3) axial noise: Gaussian of std ``sigma_z(z, theta)`` added to the depth; (4) pixels whose depth differs
-from a 4-neighbour's by more than ``edge_jump_m`` (or that border a pixel without return) lose their return.
-All draws come from the ``rng`` passed in (seeded per trial).
+``nguyen`` (:func:`nguyen_noise`): the model of Nguyen, Izadi & Lovell, "Modeling Kinect Sensor Noise for
+Improved 3D Reconstruction and Tracking" (3DIMPVT 2012), plus missing pixels at grazing angles and depth
+edges. Order: (1) pixels beyond ``max_incidence_deg`` lose their return; (2) lateral noise: each pixel takes
+the return (depth, id, angle) of the pixel offset by a Gaussian (du, dv) of std ``sigma_L(theta)`` px,
+rounded; (3) axial noise: Gaussian of std ``sigma_z(z, theta)`` added to the depth; (4) pixels whose depth
+differs from a 4-neighbour's by more than ``edge_jump_m`` (or that border a pixel without return) lose their
+return. All draws come from the ``rng`` passed in (seeded per trial).
 """
+
+from collections.abc import Callable
 
 import numpy as np
 
 from graspexp.config.perception import DepthNoiseConfig
+
+NoiseModel = Callable[..., tuple[np.ndarray, np.ndarray]]
+"""``model(cfg, depth_m, ids, cos_incidence, *, rng) -> (depth, ids)``: the sensor's frame from an exact one
+(``depth_m`` (H, W) float64 m, 0 = no return; ``ids`` (H, W); ``cos_incidence`` (H, W) cosine of the angle
+between ray and surface normal) as :func:`noisy_depth` returns it; every draw from ``rng``."""
+NOISE_MODELS: dict[str, NoiseModel] = {}
+"""The depth noise models by name (``perception.depth_noise.model``), filled by :func:`noise_model`."""
+
+
+def noise_model(name: str) -> Callable[[NoiseModel], NoiseModel]:
+    """Register the decorated function as the depth noise model ``name``."""
+
+    def register(fn: NoiseModel) -> NoiseModel:
+        NOISE_MODELS[name] = fn
+        return fn
+
+    return register
 
 
 def axial_sigma_m(cfg: DepthNoiseConfig, z_m: np.ndarray, theta_rad: np.ndarray) -> np.ndarray:
@@ -39,11 +61,25 @@ def noisy_depth(
     *,
     rng: np.random.Generator,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The sensor's frame from an exact one (module doc): (depth (H, W) float32 m, 0 = no return;
-    ids (H, W) int32, 0 where there is no return). ``cfg.enabled`` False: the exact frame as float32."""
+    """The sensor's frame from an exact one through the model ``cfg.model`` (module doc): (depth (H, W)
+    float32 m, 0 = no return; ids (H, W) int32, 0 where there is no return). ``cfg.enabled`` False: the
+    exact frame as float32."""
     depth = np.asarray(depth_m, dtype=np.float64)
     if not cfg.enabled:
         return depth.astype(np.float32), np.where(depth > 0, ids, 0).astype(np.int32)
+    return NOISE_MODELS[cfg.model](cfg, depth, ids, cos_incidence, rng=rng)
+
+
+@noise_model("nguyen")
+def nguyen_noise(
+    cfg: DepthNoiseConfig,
+    depth: np.ndarray,
+    ids: np.ndarray,
+    cos_incidence: np.ndarray,
+    *,
+    rng: np.random.Generator,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Nguyen et al. 2012's noise (module doc, steps 1-4) on the exact frame ``depth`` (float64 m)."""
     h, w = depth.shape
     theta = np.arccos(np.clip(cos_incidence, 0.0, 1.0))
     valid = (depth > 0) & (theta <= np.radians(cfg.max_incidence_deg))

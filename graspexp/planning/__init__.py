@@ -7,8 +7,16 @@
 
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.optimal import plan_optimal
-from graspexp.planning.registry import Planner, UnknownPlanner, get_planner, plan
+from graspexp.planning.registry import (
+    Planner,
+    UnknownPlanner,
+    get_planner,
+    get_scene_planner,
+    plan,
+    plan_scene,
+)
 from graspexp.planning.request import PlanRequest, PlanResult
+from graspexp.planning.scene import SceneRequest, SceneResult, TargetPlan
 
 __all__ = [
     "Grasp",
@@ -16,8 +24,13 @@ __all__ = [
     "PlanRequest",
     "PlanResult",
     "Planner",
+    "SceneRequest",
+    "SceneResult",
+    "TargetPlan",
     "UnknownPlanner",
     "get_planner",
+    "get_scene_planner",
     "plan",
     "plan_optimal",
+    "plan_scene",
 ]

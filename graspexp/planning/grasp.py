@@ -18,6 +18,9 @@ class Grasp:
     n_feasible : number of candidate paths that survived the feasibility checks (optional: 1).
     planner : registry name of the planner that made it (optional: filled in by
         :func:`graspexp.planning.plan` from ``planner.name``).
+    touches_neighbours : in a clutter scene, the grasp was planned for the target alone because none
+        clears the neighbours (the fingers or palm may touch another object: allowed by the protocol,
+        chosen last by the round). False for one object.
     extras : planner-specific scalars for logs (e.g. K, M).
     """
 
@@ -28,6 +31,7 @@ class Grasp:
     path: int = -1
     n_feasible: int = 1
     planner: str = ""
+    touches_neighbours: bool = False
     extras: dict = field(default_factory=dict)
 
     @property

@@ -287,6 +287,7 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
         path=pb,
         n_feasible=int(feasible.sum()),
         planner=req.planner.name,
+        touches_neighbours=bool(tests.relaxed[0]) if req.neighbours else False,
         extras={
             "K": k,
             "M": m,
@@ -295,7 +296,6 @@ def plan_optimal(req: PlanRequest) -> PlanResult:
             "centre_shift_m": shift_m,
             "widened": widened,
             **({"n_collides": n_collides} if pl.swept_check else {}),
-            **({"touches_neighbours": bool(tests.relaxed[0])} if req.neighbours else {}),
             **({"n_outside_area": n_outside, "in_area_required": float(need)} if need > 0 else {}),
         },
     )

@@ -97,7 +97,7 @@ def _check_params(pl) -> None:
 def plan_optimal_plus(req: PlanRequest) -> PlanResult:
     """Plan one grasp with the paper's candidates and the checks of the module doc. In a clutter round, when
     no grasp clears the neighbours and ``planner.neighbour_fallback`` is on, the grasp planned for the target
-    alone (touching a neighbour is allowed; ``extras["touches_neighbours"]``). Both searches read one
+    alone (touching a neighbour is allowed; :attr:`Grasp.touches_neighbours`). Both searches read one
     :class:`_TryTable`: a try is placed and tested once.
 
     Raises
@@ -124,9 +124,7 @@ def plan_optimal_plus(req: PlanRequest) -> PlanResult:
         if not pl.neighbour_fallback:
             raise
         result = _plan(dataclasses.replace(req, neighbours=()), alone, table, com)
-        result.grasp.extras["touches_neighbours"] = True
-        return result
-    result.grasp.extras["touches_neighbours"] = False
+        return dataclasses.replace(result, grasp=dataclasses.replace(result.grasp, touches_neighbours=True))
     return result
 
 

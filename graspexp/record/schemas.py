@@ -19,6 +19,7 @@ import types
 import typing
 
 from graspexp.core.outcome import TrialResult
+from graspexp.core.phases import Phase
 from graspexp.core.rounds import AttemptResult, RoundResult
 
 SCHEMA_ENCODING = "jsonschema"
@@ -84,28 +85,9 @@ TOPIC_SCHEMAS: dict[str, str] = {
 }
 """Topic -> schema name, one channel per topic."""
 
-PHASE_NAMES = (
-    "drop",
-    "settled",
-    "settle_timeout",
-    "plan",
-    "pre_grasp",
-    "approach",
-    "settle_arm",
-    "close",
-    "remove_support",
-    "pull_back",
-    "lift",
-    "hold",
-    "done",
-    "quality",
-    "failed",
-    "remove_tray",
-    "taken_away",
-    "attempt_end",
-    "round_end",
-)
-"""The phase names the trial protocol uses (the Phase schema accepts any string)."""
+PHASE_NAMES = tuple(p.value for p in Phase)
+"""The phase names the trial and round protocols use (:class:`graspexp.core.phases.Phase`; the Phase schema
+accepts any string)."""
 
 METADATA_NAME = "graspexp"
 """Name of the MCAP metadata record holding the resolved config, seeds and versions."""
@@ -183,6 +165,10 @@ def _planned_grasp() -> dict:
             "K": {**integer_or_null, "description": "Number of clusters"},
             "M": {**integer_or_null, "description": "Number of approach paths per cluster"},
             "n_feasible": {"type": "integer", "minimum": 0, "description": "Number of feasible paths"},
+            "touches_neighbours": {
+                "type": "boolean",
+                "description": "Planned for the target alone: the gripper may touch a neighbour (clutter)",
+            },
         },
         "required": ["timestamp", "pose", "approach", "width_m", "cost", "planner", "n_feasible"],
     }

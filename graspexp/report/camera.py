@@ -5,8 +5,9 @@ ones. Read from the ``results.csv`` files (or logs) of sweeps (:func:`graspexp.r
 Columns (:data:`COLUMNS`): ``optimal`` with the exact pose (``perception.source=truth``, no pose noise),
 ``optimal`` and ``optimal_plus`` with the registered pose (``perception.source=depth`` from a prior:
 :func:`_registered`), ``antipodal`` on the full model, ``antipodal_view`` on the camera's cloud only, and
-the learned ``vgn`` on the camera's views (:data:`LEARNED_COLUMNS`); then the paper's GPD, PointNetGPD
-2-class and 3-class (other papers' real robots, copied) and its own column for the setting.
+every learned planner installed on the camera's views (:func:`learned_columns`, e.g. ``vgn``); then the
+paper's GPD, PointNetGPD 2-class and 3-class (other papers' real robots, copied) and its own column for the
+setting.
 """
 
 from collections.abc import Sequence
@@ -15,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from graspexp.config.plugins import learned_planners
 from graspexp.report.collect import collect
 from graspexp.report.paper import BASELINES, SETTING_LABELS, SETTINGS, TABLE1
 from graspexp.report.pose_error import success_by_pose_error
@@ -29,10 +31,16 @@ COLUMNS = (
     ("antipodal_view", False, "antipodal_view, camera cloud"),
 )
 """(planner, registered pose, column label) of the measured columns."""
-LEARNED_COLUMNS = (("vgn", False, "vgn, gripper=panda, camera views"),)
-"""The learned planners' columns. ``results.csv`` does not record the gripper: the label states how the
-results page runs them (``gripper=panda``, the gripper VGN was trained for)."""
 Column = tuple[str, bool, str]
+
+
+def learned_columns() -> tuple[Column, ...]:
+    """The learned planners' columns, one per installed planner whose plugin declares itself learned
+    (:func:`graspexp.config.plugins.learned_planners`), labelled by it
+    (:meth:`graspexp.config.plugins.Learned.column_label`). ``results.csv`` does not record the gripper: the
+    label states how the results page runs them (the gripper each was trained for, e.g. ``vgn, gripper=panda,
+    camera views``)."""
+    return tuple((name, False, learned.column_label(name)) for name, learned in learned_planners().items())
 
 
 def _cell(g: pd.DataFrame) -> str:

@@ -11,11 +11,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from graspexp.config.mode import CLUTTER_MODES
-from graspexp.core.run_layout import TRIALS_DIR
 from graspexp.record import CorruptLogError, TrialLog, read_trial
 from graspexp.report.gallery import draw_instants, pose_at
 from graspexp.report.render import markdown
+from graspexp.report.round_tables import round_log_dirs
 
 SCENE_HALF_M = 0.2
 """Half the side of the cube drawn around the attempt's grasp point (or its target), m: the 0.3 m
@@ -23,10 +22,9 @@ workspace and the neighbours around it."""
 
 
 def round_logs(root: Path | str) -> list[Path]:
-    """The finished round logs below ``root`` (``trials/pile/*.mcap``, ``trials/packed/*.mcap`` of every run
-    directory), sorted by path."""
-    root = Path(root)
-    found = [p for mode in CLUTTER_MODES for p in root.rglob(f"{TRIALS_DIR}/{mode}/*.mcap")]
+    """The finished round logs below ``root`` (``trials/<mode.name>/*.mcap`` of every clutter run directory,
+    :func:`graspexp.report.round_tables.round_log_dirs`), sorted by path."""
+    found = [p for d in round_log_dirs(root) for p in d.glob("*.mcap")]
     return sorted(p for p in found if p.is_file())  # an unfinished log is NNN.mcap.partial
 
 

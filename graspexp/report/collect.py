@@ -109,7 +109,7 @@ def _log_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
                 raise CorruptLogError(f"{path}: its recorded config is not a job config")
             result_from_dict(result)
         except (CorruptLogError, OSError, ValueError) as exc:
-            if not _is_round_log(path):  # a clutter round's log is read by graspexp.report.round_tables
+            if not is_round_log(path):  # a clutter round's log is read by graspexp.report.round_tables
                 unreadable.append((path, str(exc) if str(path) in str(exc) else f"{path}: {exc}"))
             continue
         row = _row(result, path, noise_of(config))
@@ -120,7 +120,7 @@ def _log_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
     return rows, unreadable
 
 
-def _is_round_log(path: Path) -> bool:
+def is_round_log(path: Path) -> bool:
     """Whether ``path`` is a clutter round's complete log (a /round message in place of /result)."""
     try:
         read_round(path)

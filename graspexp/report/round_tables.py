@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from graspexp.config.mode import CLUTTER_MODES
 from graspexp.core.rounds import RoundEnd, RoundResult
 from graspexp.core.run_layout import ATTEMPTS_CSV, ROUNDS_CSV, TRIALS_DIR
 from graspexp.record import CorruptLogError, iter_trial_logs, read_round
+from graspexp.report.collect import is_round_log
 from graspexp.report.stats import percentiles, success_pct
 
 
@@ -22,9 +22,7 @@ def rounds_frame(rounds: Iterable[RoundResult]) -> pd.DataFrame:
     for r in rounds:
         d = r.to_dict()
         d.pop("attempts")
-        d.update(
-            n_placed=r.n_placed, n_removed=r.n_removed, n_attempts=sum(a["executed"] for a in r.attempts)
-        )
+        d.update(n_placed=r.n_placed, n_removed=r.n_removed, n_attempts=sum(a.executed for a in r.attempts))
         for key in ("drawn", "placed", "removed"):
             d[key] = " ".join(d[key])
         rows.append(d)
@@ -37,7 +35,7 @@ def attempts_frame(rounds: Iterable[RoundResult]) -> pd.DataFrame:
     rows = []
     for r in rounds:
         for a in r.attempts:
-            row = {"dataset": r.dataset, "mode": r.mode, "planner": r.planner, **a}
+            row = {"dataset": r.dataset, "mode": r.mode, "planner": r.planner, **a.to_dict()}
             for key in ("touched_neighbours", "moved_neighbours"):
                 row[key] = " ".join(row[key])
             rows.append(row)
@@ -58,12 +56,23 @@ def read_rounds(run_dir: Path | str) -> list[RoundResult]:
     return _rounds_from_csv(Path(run_dir))
 
 
+def round_log_dirs(root: Path | str) -> list[Path]:
+    """The folders below ``root`` that hold a clutter job's round logs (``trials/<mode.name>/`` of a run
+    directory: a folder of one job's logs holds one kind, so its first finished log tells), sorted."""
+    out = []
+    for folder in sorted({p.parent for p in Path(root).rglob(f"{TRIALS_DIR}/*/*.mcap")}):
+        first = next(iter(sorted(folder.glob("*.mcap"))), None)
+        if first is not None and is_round_log(first):
+            out.append(folder)
+    return out
+
+
 def find_rounds(root: Path | str) -> list[RoundResult]:
     """Every round below ``root`` (a run or a sweep directory): the run directories that hold a ``rounds.csv``
-    or round logs (``trials/pile/``, ``trials/packed/``), each read by :func:`read_rounds`."""
+    or round logs (:func:`round_log_dirs`), each read by :func:`read_rounds`."""
     root = Path(root)
     runs = {p.parent for p in root.rglob(ROUNDS_CSV)}
-    runs |= {d.parent for mode in CLUTTER_MODES for d in root.rglob(f"{TRIALS_DIR}/{mode}") if d.is_dir()}
+    runs |= {d.parent.parent for d in round_log_dirs(root)}
     return [r for run in sorted(runs) for r in read_rounds(run)]
 
 

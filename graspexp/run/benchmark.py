@@ -13,7 +13,6 @@ from pathlib import Path
 
 import pandas as pd
 
-from graspexp.config.mode import CLUTTER_MODES
 from graspexp.config.plugins import LoadedPlanner, get_plugin, load_planners
 from graspexp.core.rounds import RoundResult
 from graspexp.core.run_layout import ROUNDS_CSV, SUMMARY_MD, results_csv
@@ -22,6 +21,7 @@ from graspexp.report.collect import collect
 from graspexp.report.contact_area import finger_contacts_in_area
 from graspexp.report.paper import PAPER_TABLES, SETTINGS, TRIALS_PER_SETTING
 from graspexp.report.round_tables import find_rounds
+from graspexp.run.job_config import clutter_modes
 from graspexp.run.multirun import multirun_command
 from graspexp.run.provenance import package_versions
 from graspexp.run.suites import NOISE_LEVELS, Job, benchmark_suite
@@ -121,7 +121,7 @@ def run_all(bench: Benchmark, todo: list[Job]) -> list[str]:
     for planner_jobs in by_planner.values():
         rc = subprocess.call(sweep_command(bench, planner_jobs))
         for job in planner_jobs:
-            done = Path(job.run_dir) / ROUNDS_CSV if job.mode in CLUTTER_MODES else results_csv(job.run_dir)
+            done = Path(job.run_dir) / ROUNDS_CSV if job.mode in clutter_modes() else results_csv(job.run_dir)
             if not done.is_file():
                 errors.append(f"{job.run_dir}: no results (the sweep of {job.planner} exited {rc})")
     return errors
@@ -131,7 +131,7 @@ def clutter_rounds(all_jobs: list[Job]) -> dict[tuple[float, float], list[RoundR
     """The rounds of the clutter jobs, per pose-noise level (mm, degrees), zero first."""
     levels: dict[tuple[float, float], list[RoundResult]] = {}
     for job in all_jobs:
-        if job.mode in CLUTTER_MODES and Path(job.run_dir).is_dir():
+        if job.mode in clutter_modes() and Path(job.run_dir).is_dir():
             levels.setdefault((job.trans_mm, job.rot_deg), []).extend(find_rounds(job.run_dir))
     return dict(sorted(levels.items(), key=lambda kv: kv[0] != (0.0, 0.0)))
 

@@ -1,6 +1,6 @@
 """A job's objects made ready for their trials (model, collision shape, Foxglove scene), and the one
 place a trial's context is set up from a config and an object: the runner, re-simulation, the benches and
-the tests all go through :func:`load_sim_object` and :func:`trial_context`."""
+the tests all go through :func:`load_sim_object`, :func:`trial_context` and :func:`round_context`."""
 
 import dataclasses
 import logging
@@ -11,10 +11,12 @@ from graspexp.config.job import JobConfig
 from graspexp.core.seeding import trial_seed
 from graspexp.datasets import ObjectError, job_object
 from graspexp.datasets.model import ObjectModel
-from graspexp.planning import plan
+from graspexp.planning import plan, plan_scene
+from graspexp.planning.scene import ScenePlanner
 from graspexp.quality import fc_min_mu
 from graspexp.record.scene import ObjectScene, object_scene
 from graspexp.sim.collision_shapes import ShapeError, shape_with_fallback
+from graspexp.sim.rounds import RoundContext, RoundObject
 from graspexp.sim.shape import CollisionShape
 from graspexp.sim.trial import LogSink, NullRecorder, PlanFn, TrialContext, plain_config
 
@@ -79,3 +81,22 @@ def trial_context(
     return TrialContext(
         plain, loaded.model, loaded.hulls, trial, seed, rec, loaded.scene, plan=plan, quality=fc_min_mu
     )
+
+
+def round_context(
+    plain: JobConfig,
+    loaded: list[LoadedObject],
+    round_index: int,
+    seed: int,
+    recorder: LogSink | None = None,
+    scene: object | None = None,
+    *,
+    planner: ScenePlanner = plan_scene,
+) -> RoundContext:
+    """The context of round ``round_index`` (seed ``seed``) of the drawn objects ``loaded`` (by slot) under job
+    config ``plain``: ``recorder`` (None: nothing logged), the round's Foxglove scene (None: none), the scene
+    planner (default :func:`graspexp.planning.plan_scene`; a per-object planner through
+    :func:`graspexp.planning.scene.per_object`) and the force-closure quality check."""
+    rec = NullRecorder() if recorder is None else recorder
+    objects = [RoundObject(o.model, o.hulls) for o in loaded]
+    return RoundContext(plain, objects, round_index, seed, rec, scene, plan_scene=planner, quality=fc_min_mu)

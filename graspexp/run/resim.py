@@ -8,10 +8,8 @@ import numpy as np
 from graspexp.config.errors import ConfigError
 from graspexp.config.registry import job_config_from_yaml
 from graspexp.datasets.catalog import DATA_ENV
-from graspexp.planning import plan
-from graspexp.quality import fc_min_mu
-from graspexp.run.objects import load_sim_object, trial_context
-from graspexp.sim.rounds import RoundContext, RoundObject, run_round
+from graspexp.run.objects import load_sim_object, round_context, trial_context
+from graspexp.sim.rounds import run_round
 from graspexp.sim.trial import NullRecorder, plain_config, run_trial
 
 POSE_TOLERANCE = 1e-6
@@ -108,15 +106,7 @@ def _resimulate_round(log, cfg, plain) -> tuple[bool, str]:
         raise ConfigError("the round log's metadata lacks round_objects (the objects drawn for the round)")
     loaded = [load_sim_object(cfg, name, plain) for name in names]
     capture = _PoseCapture()
-    ctx = RoundContext(
-        plain,
-        [RoundObject(o.model, o.hulls) for o in loaded],
-        int(meta["trial"]),
-        int(meta["trial_seed"]),
-        capture,
-        plan=plan,
-        quality=fc_min_mu,
-    )
+    ctx = round_context(plain, loaded, int(meta["trial"]), int(meta["trial_seed"]), capture)
     result = run_round(ctx)
     logged = log.round_result
     problems = []
@@ -126,7 +116,7 @@ def _resimulate_round(log, cfg, plain) -> tuple[bool, str]:
             f"end={result.end} removed={result.removed}"
         )
     key = ("attempt", "target", "slot", "success", "reason")
-    ours = [tuple(a[k] for k in key) for a in result.attempts]
+    ours = [tuple(getattr(a, k) for k in key) for a in result.attempts]
     theirs = [tuple(a[k] for k in key) for a in logged["attempts"]]
     if ours != theirs:
         problems.append(f"attempts differ: logged {theirs}, re-simulated {ours}")

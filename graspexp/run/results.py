@@ -1,9 +1,10 @@
 """Results pages made from runs of the current code: ``python -m graspexp results`` regenerates them,
 ``python -m graspexp results --check`` tells which ones the code no longer reproduces.
 
-A :class:`Page` (registered in :data:`graspexp.run.result_pages.PAGES`) declares
+A :class:`Page` (registered in :func:`graspexp.run.result_pages.pages`) declares
 
-- its sweeps (:class:`Sweep`: a reading of :mod:`graspexp.run.suites` and extra overrides), each a Hydra
+- its sweeps (:class:`graspexp.run.suites.Sweep`: a reading and extra overrides, defined in
+  :mod:`graspexp.run.suites` with every other job matrix), each a Hydra
   multirun over the paper's four settings (:func:`graspexp.run.suites.reading_sweep`, the joblib
   launcher unless the overrides name another, e.g. ``hydra/launcher=submitit_slurm``);
 - how its generated block is rendered from those runs (``render``, from :mod:`graspexp.report`);
@@ -14,8 +15,9 @@ A :class:`Page` (registered in :data:`graspexp.run.result_pages.PAGES`) declares
 once; an interrupted regeneration continues: each sweep resumes its own trials, and a finished sweep is
 marked and skipped), then the fingerprint jobs, then writes each page's block. :func:`check` re-runs the
 fingerprint jobs into a temporary folder and compares each page's stamp. A page whose sweeps name a planner
-that cannot run here (``planner=vgn`` without the optional extra ``learned`` or its checkpoint:
-:func:`unavailable`) is skipped by both, with one line saying why.
+that cannot run here (a learned planner such as ``planner=vgn`` without the optional extra ``learned`` or its
+checkpoint: :func:`unavailable`) is skipped by both, with one line saying why; :func:`learned_pages` are the
+pages that run a learned planner (``nox -s learned`` checks them).
 """
 
 from __future__ import annotations
@@ -55,33 +57,10 @@ from graspexp.report.pages import (
 )
 from graspexp.run.multirun import multirun_command
 from graspexp.run.provenance import cpu_class, cpu_flags, machine_fingerprint
-from graspexp.run.suites import Reading, reading_sweep
+from graspexp.run.suites import FINGERPRINT_SETTINGS, FINGERPRINT_SUBSET, Sweep, reading_sweep
 
-FINGERPRINT_SETTINGS: tuple[tuple[str, str], ...] = (("collab", "z"), ("bin", "xyz"))
-"""(mode, rot) of every fingerprint job: one setting of each mode, the turned drop in bin picking."""
-FINGERPRINT_SUBSET: tuple[str, ...] = ("dataset=ycb", "objects=[025_mug,035_power_drill]", "trials=1")
-"""The default fingerprint objects and trials: two Table 1 objects, one drop each per setting."""
 DONE_NAME = ".graspexp-results-done.json"
 """Marker a finished sweep leaves in its directory: command, exit status, wall and CPU seconds."""
-
-
-@dataclass(frozen=True)
-class Sweep:
-    """One sweep of a page: a reading (name, overrides, what it is) and overrides beside it (``trials=30``,
-    another dataset or object list), run on the paper's four settings."""
-
-    reading: Reading
-    extra: tuple[str, ...] = ()
-    settings: bool = True
-    """Run on the paper's four settings and both tables (:func:`graspexp.run.suites.reading_sweep`);
-    False: the reading's overrides are the whole sweep (e.g. an Optuna study, ``hydra/sweeper=study``)."""
-
-    @property
-    def name(self) -> str:
-        """The reading's name, and a hash of the extra overrides when there are any."""
-        if not self.extra:
-            return self.reading.name
-        return f"{self.reading.name}-{hashlib.sha256(' '.join(self.extra).encode()).hexdigest()[:8]}"
 
 
 @dataclass(frozen=True)
@@ -154,22 +133,37 @@ def fingerprint_jobs(page: Page, overrides: Sequence[str] = ()) -> list[tuple[st
     ]
 
 
+def page_planners(page: Page) -> list[str]:
+    """Every planner that ``page``'s sweeps and fingerprint jobs name (``planner=a,b``), in order, once."""
+    names: dict[str, None] = {}
+    for sweep in (*page.sweeps, *page.fingerprint):
+        for override in (*sweep.reading.overrides, *sweep.extra):
+            key, _, value = override.partition("=")
+            if key.lstrip("+~") == "planner":
+                names |= dict.fromkeys(value.split(","))
+    return list(names)
+
+
 def unavailable(page: Page) -> str:
     """'' when every planner that ``page``'s sweeps and fingerprint jobs name can run here; else one line:
     the first that cannot and why (its plugin's ``unavailable``, e.g. the optional extra to install)."""
     from graspexp.config.plugins import get_plugin
 
-    for sweep in (*page.sweeps, *page.fingerprint):
-        for override in (*sweep.reading.overrides, *sweep.extra):
-            key, _, value = override.partition("=")
-            if key.lstrip("+~") != "planner":
-                continue
-            for name in value.split(","):
-                plugin = get_plugin(name).plugin
-                why = plugin.unavailable() if plugin.unavailable is not None else ""
-                if why:
-                    return f"page {page.name} ({page.path}) skipped: planner={name} cannot run here: {why}"
+    for name in page_planners(page):
+        plugin = get_plugin(name).plugin
+        why = plugin.unavailable() if plugin.unavailable is not None else ""
+        if why:
+            return f"page {page.name} ({page.path}) skipped: planner={name} cannot run here: {why}"
     return ""
+
+
+def learned_pages(pages: Sequence[Page]) -> list[Page]:
+    """The pages of ``pages`` that run a learned planner (a plugin declaring
+    :attr:`graspexp.config.plugins.PlannerPlugin.learned`)."""
+    from graspexp.config.plugins import learned_planners
+
+    learned = learned_planners()
+    return [page for page in pages if any(name in learned for name in page_planners(page))]
 
 
 def available(pages: Sequence[Page]) -> list[Page]:

@@ -19,12 +19,10 @@ from graspexp.core.run_layout import (
     LinkedRunPathError,
     check_not_linked,
     real_folder,
+    round_log_path,
     summary_md,
-    trial_log_path,
 )
 from graspexp.core.seeding import rng_for, round_seed
-from graspexp.planning import plan
-from graspexp.quality import fc_min_mu
 from graspexp.record import read_round, trial_recorder
 from graspexp.record.scene import round_bodies, round_scene
 from graspexp.record.writer import is_write_error
@@ -35,10 +33,10 @@ from graspexp.report.round_tables import (
     rounds_frame,
 )
 from graspexp.run.locks import RunError
-from graspexp.run.objects import LoadedObject
+from graspexp.run.objects import LoadedObject, round_context
 from graspexp.run.provenance import job_metadata
 from graspexp.run.resume import finished_log
-from graspexp.sim.rounds import RoundContext, RoundObject, run_round
+from graspexp.sim.rounds import run_round
 from graspexp.sim.trial import plain_config
 
 log = logging.getLogger(__name__)
@@ -65,7 +63,7 @@ def run_rounds(
     for r in range(cfg.trials):
         seed = round_seed(plain, r)
         drawn = draw_objects(pool, int(cfg.mode.objects_per_round), seed)
-        path = trial_log_path(run_dir, cfg.mode.name, r)
+        path = round_log_path(run_dir, cfg.mode.name, r)
         try:
             real_folder(run_dir, path.parent)
         except LinkedRunPathError as exc:
@@ -87,16 +85,7 @@ def _run_one(cfg, plain, job_meta, path: Path, r: int, seed: int, loaded: list[L
     try:
         with trial_recorder(path if cfg.record else None, meta, plain, bodies) as rec:
             scene = round_scene(plain, [o.hulls for o in loaded]) if cfg.record else None
-            ctx = RoundContext(
-                plain,
-                [RoundObject(o.model, o.hulls) for o in loaded],
-                r,
-                seed,
-                rec,
-                scene,
-                plan=plan,
-                quality=fc_min_mu,
-            )
+            ctx = round_context(plain, loaded, r, seed, rec, scene)
             try:
                 result = run_round(ctx)
             except Exception as exc:  # one round's error is recorded; the job goes on
@@ -159,7 +148,7 @@ def write_round_summary(run_dir: Path, results: list[RoundResult]) -> str:
 def round_objective(results: list[RoundResult]) -> float:
     """A clutter job's objective: its GSR as a fraction (successful / executed attempts over the rounds); 0
     when the planner found no grasp in any round (no object was removed: a result, not an error)."""
-    executed = [a["success"] for r in results for a in r.attempts if a["executed"]]
+    executed = [a.success for r in results for a in r.attempts if a.executed]
     return float(np.mean(executed)) if executed else 0.0
 
 

@@ -18,7 +18,7 @@ from omegaconf import DictConfig, OmegaConf
 from threadpoolctl import threadpool_limits
 from tqdm import tqdm
 
-from graspexp.config.mode import CLUTTER_MODES
+from graspexp.config.mode import is_clutter
 from graspexp.core.outcome import TrialResult
 from graspexp.datasets import select_objects
 from graspexp.run.job_config import make_ready
@@ -77,7 +77,7 @@ def _run_trials(
     wall0: float,
     cpu0: float,
 ) -> float:
-    if cfg.mode.name in CLUTTER_MODES:
+    if is_clutter(cfg.mode):
         return timed_rounds(cfg, run_dir, objects, models, wall0, cpu0)
     results: list[TrialResult] = []
     with tqdm(

@@ -8,7 +8,8 @@ The pose is the identity rotation translated so that the mesh's lowest point sit
 
 A job that renders the depth camera (``perception.source=depth``, or a planner that reads it) gets the
 camera's observation of the object on the support and, with ``perception.source=depth``, the pose
-registered from it, as a trial does (:func:`graspexp.sim.perceive.perceive`, with that trial's seed).
+registered from it, as a trial does (:func:`graspexp.perception.scene_view.perceive`, with that trial's
+seed).
 """
 
 import dataclasses
@@ -81,7 +82,7 @@ def posed_request(cfg: Any, model: ObjectModel, pose: np.ndarray, trial: int) ->
         seed=plan_seed(trial_seed(cfg, model.name, trial)),
         support_blocks_gripper=bool(cfg.mode.support_collides_with_gripper),
     )
-    from graspexp.sim.perceive import perceive, wants_camera
+    from graspexp.perception.scene_view import perceive, wants_camera
 
     if not wants_camera(cfg):
         return req

@@ -5,7 +5,7 @@ The protocol of VGN (Breyer et al., CoRL 2020; ethz-asl/vgn ``experiments/clutte
 lifted away (pile) or stood upright side by side (packed); once they rest, objects outside the workspace
 are taken away and the rest count as placed. Each attempt plans (every object's model at its perceived
 pose; the planner sees the others as obstacles; ``mode.pick_order`` chooses the target), executes the grasp
-exactly as a ``bin`` trial does (:func:`graspexp.sim.trial._execute`: approach, close, pull back, lift,
+exactly as a ``bin`` trial does (:func:`graspexp.sim.trial.execute_grasp`: approach, close, pull back, lift,
 hold; gripper-table contact fails it; touching a neighbour is allowed and recorded) and scores it. A held
 object is taken away; the others stay where the attempt left them and settle. The round ends when no
 object is left, the planner finds no grasp, or ``mode.max_consecutive_failures`` attempts in a row fail.
@@ -21,46 +21,23 @@ from graspexp.config import JobConfig
 from graspexp.core.bodies import clutter_body
 from graspexp.core.geometry import matrix_to_quat_wxyz, transform_points
 from graspexp.core.outcome import FailureReason, TrialResult
+from graspexp.core.phases import Phase
 from graspexp.core.rounds import AttemptResult, RoundEnd, RoundResult
 from graspexp.core.seeding import derive_seed, rng_for
-from graspexp.datasets.model import ObjectModel
-from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
+from graspexp.perception.scene_view import ScenePerceived, perceive_scene, slot_id
+from graspexp.planning.grasp import Grasp
 from graspexp.planning.request import Neighbour, PlanRequest
-from graspexp.sim.clutter_scene import (
-    ClutterScene,
-    add_clutter_object,
-    clutter_scene,
-    packed_poses,
-    pile_drop_pose,
-)
-from graspexp.sim.contacts import gripper_touches
-from graspexp.sim.perceive import ScenePerceived, perceive_scene, slot_id
-from graspexp.sim.shape import CollisionShape
-from graspexp.sim.trial import (
-    LogSink,
-    NullRecorder,
-    PlanFn,
-    QualityFn,
-    TrialContext,
-    TrialFailed,
-    _execute,
-    _grasp_record,
-    _Sim,
-)
+from graspexp.planning.scene import ScenePlanner, SceneRequest, timed
+from graspexp.sim.round_scene import RoundObject, clutter_scene
+from graspexp.sim.round_sim import RoundSim, settle_all
+from graspexp.sim.scene_types import SceneType, scene_type
+from graspexp.sim.trial import LogSink, NullRecorder, QualityFn, TrialFailed, execute_grasp, grasp_record
 
 MOVED_M = 0.01
 """A neighbour whose origin ended farther than this from where it was before an attempt was moved by it, m."""
 PLANNING_MODE = "bin"
 """What a planner is told the mode is (:attr:`PlanRequest.mode`): the table under a clutter round is the
 bin's, so the paper's Eq. (2)-(3) score the paths."""
-
-
-@dataclass(frozen=True)
-class RoundObject:
-    """One drawn object of a round: its model and collision shape."""
-
-    model: ObjectModel
-    shape: CollisionShape
 
 
 @dataclass
@@ -75,51 +52,10 @@ class RoundContext:
     recorder: LogSink = field(default_factory=NullRecorder)
     scene: object | None = None
     """The round's Foxglove scene (:func:`graspexp.record.scene.round_scene`); None: no /scene messages."""
-    plan: PlanFn = field(kw_only=True)
+    plan_scene: ScenePlanner = field(kw_only=True)
+    """Plans the scene's grasps (the runner passes :func:`graspexp.planning.plan_scene`; a per-object planner
+    through :func:`graspexp.planning.scene.per_object`)."""
     quality: QualityFn = field(kw_only=True)
-
-
-class _RoundSim(_Sim):
-    """:class:`_Sim` over several objects: logs every object's pose, checks the target's speed, and at every
-    log tick (whether or not recorded) notes which neighbours the gripper touches."""
-
-    def __init__(self, ts: ClutterScene, cfg: JobConfig, recorder: LogSink, timings: dict[str, float]):
-        super().__init__(ts, cfg, recorder, timings)
-        self.touched: set[str] = set()
-
-    def track(self, name: str) -> None:
-        """Make body ``name`` the target: the speed check and the finger forces follow it."""
-        self.ts.target(name)
-        body = self.ts.object_body
-        self._velocities = (body.get_linear_velocity, body.get_angular_velocity)
-        self._last_velocities = None
-
-    def frames(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-        out = {}
-        for name, (entity, _) in self.ts.bodies.items():
-            p = entity.pose
-            out[name] = (p.p, p.q)
-        if self.gripper is not None:
-            for link in (self.gripper.palm, *self.gripper.fingers):
-                lp = link.entity_pose
-                out[link.name] = (lp.p, lp.q)
-        return out
-
-    def steps_n(self, n: int, moves: list | None = None) -> None:
-        done = 0
-        while done < n:
-            k = min(self.log_every, n - done)
-            super().steps_n(k, None if moves is None else moves[done : done + k])
-            done += k
-            if self.gripper is not None:
-                self.touched |= gripper_touches(self._contacts(), self.ts.object_entity.name)
-
-    def release_gripper(self) -> None:
-        """Take the gripper out of the scene after an attempt."""
-        if self.gripper is not None:
-            for link in self.gripper.articulation.links:
-                self.ts.scene.remove_entity(link.entity)
-        self.gripper, self._links, self.touch = None, None, None
 
 
 def run_round(ctx: RoundContext) -> RoundResult:
@@ -138,76 +74,36 @@ def run_round(ctx: RoundContext) -> RoundResult:
         end=RoundEnd.ERROR.value,
     )
     timings = dict.fromkeys(("build", "settle", "plan", "quality", "execute", "log", "physics"), 0.0)
+    kind = scene_type(cfg.mode.scene)
     ts = clutter_scene(cfg.mode, cfg)
-    sim = _RoundSim(ts, cfg, ctx.recorder, timings)
+    kind.fixtures(ts, cfg)
+    sim = RoundSim(ts, cfg, ctx.recorder, timings)
     if ctx.scene is not None:
         ctx.recorder.scene(0.0, ctx.scene.static)
     try:
-        _place(ctx, sim)
+        _place(ctx, sim, kind)
         res.placed = sorted(ts.bodies)
-        sim.phase("settled", {"placed": res.placed})
+        sim.phase(Phase.SETTLED, {"placed": res.placed})
         res.end = _attempts(ctx, sim, res).value
     except TrialFailed as e:  # the scene itself went unstable while settling
         res.error = str(e)
-        sim.phase("failed", {"reason": e.reason.value, "detail": str(e)})
+        sim.phase(Phase.FAILED, {"reason": e.reason.value, "detail": str(e)})
     res.wall_s, res.cpu_s = time.perf_counter() - wall0, time.process_time() - cpu0
     res.sim_time_s = sim.t
-    sim.phase("round_end", {"end": res.end, "removed": res.removed})
+    sim.phase(Phase.ROUND_END, {"end": res.end, "removed": res.removed})
     return res
 
 
-def _place(ctx: RoundContext, sim: _RoundSim) -> None:
-    """Drop (pile) or stand (packed) the drawn objects, settle, lift the tray away, settle, and take away
-    every object outside the workspace or off the table."""
-    cfg, ts = ctx.cfg, sim.ts
-    mode = cfg.mode
-    rng = rng_for(ctx.round_seed, "place")
-    sim.phase("drop", {"objects": [o.model.name for o in ctx.objects]})
-    if mode.name == "pile":
-        for slot, obj in enumerate(ctx.objects):
-            top = max((ts.bodies[b][1].compute_global_aabb_tight()[1][2] for b in ts.bodies), default=0.0)
-            pose = pile_drop_pose(obj.model, mode, float(top), rng)
-            add_clutter_object(ts, clutter_body(slot), obj.model, obj.shape, pose, cfg)
-            _settle_all(sim)
-        sim.phase("remove_tray")
-        ts.remove_tray()
-    else:
-        poses = packed_poses([o.model for o in ctx.objects], mode, float(cfg.rot.drop_height_m), rng)
-        for slot, (obj, pose) in enumerate(zip(ctx.objects, poses, strict=True)):
-            if pose is not None:
-                add_clutter_object(ts, clutter_body(slot), obj.model, obj.shape, pose, cfg)
-    _settle_all(sim)
+def _place(ctx: RoundContext, sim: RoundSim, kind: SceneType) -> None:
+    """Bring the drawn objects onto the table as the scene type does, settle, and take away every object
+    outside the workspace or off the table."""
+    sim.phase(Phase.DROP, {"objects": [o.model.name for o in ctx.objects]})
+    kind.place(sim, ctx.objects, rng_for(ctx.round_seed, "place"))
+    settle_all(sim)
     _take_away_outside(ctx, sim)
 
 
-def _settle_all(sim: _RoundSim) -> bool:
-    """Step until every object rests (both settle speeds for ``sim.settle_hold_s``, after
-    ``sim.settle_min_s``) or ``sim.settle_max_s`` runs out; whether they came to rest."""
-    cfg = sim.cfg.sim
-    bodies = [b for _, b in sim.ts.bodies.values()]
-    if not bodies:
-        return True
-    sim.track(next(iter(sim.ts.bodies)))
-    linear_sq, angular_sq = cfg.settle_linear_mps**2, cfg.settle_angular_radps**2
-    min_steps, hold = int(cfg.settle_min_s / sim.dt), max(1, round(cfg.settle_hold_s / sim.dt))
-    still = 0
-    with sim.timed("settle"):
-        for i in range(int(cfg.settle_max_s / sim.dt)):
-            sim.step()
-            rest = True
-            for body in bodies:
-                v, w = body.get_linear_velocity(), body.get_angular_velocity()
-                if v.dot(v) >= linear_sq or w.dot(w) >= angular_sq:
-                    rest = False
-                    break
-            still = still + 1 if rest else 0
-            if i + 1 >= min_steps and still >= hold:
-                return True
-    sim.phase("settle_timeout", {"cap_s": cfg.settle_max_s})
-    return False
-
-
-def _take_away_outside(ctx: RoundContext, sim: _RoundSim) -> list[str]:
+def _take_away_outside(ctx: RoundContext, sim: RoundSim) -> list[str]:
     """Remove the objects whose centre of mass is outside the workspace or that fell off the table (VGN's
     ``remove_objects_outside_roi``); their names."""
     ts, mode = sim.ts, ctx.cfg.mode
@@ -220,17 +116,17 @@ def _take_away_outside(ctx: RoundContext, sim: _RoundSim) -> list[str]:
             gone.append(name)
             _remove(ctx, sim, name)
     if gone:
-        sim.phase("taken_away", {"bodies": gone})
+        sim.phase(Phase.TAKEN_AWAY, {"bodies": gone})
     return gone
 
 
-def _remove(ctx: RoundContext, sim: _RoundSim, name: str) -> None:
+def _remove(ctx: RoundContext, sim: RoundSim, name: str) -> None:
     sim.ts.remove_body(name)
     if ctx.scene is not None:
         ctx.recorder.delete_entities(sim.log_t, ctx.scene.bodies[name])
 
 
-def _attempts(ctx: RoundContext, sim: _RoundSim, res: RoundResult) -> RoundEnd:
+def _attempts(ctx: RoundContext, sim: RoundSim, res: RoundResult) -> RoundEnd:
     """Grasp until the table is clear, no grasp is found, or the failure limit; each attempt's row into
     ``res.attempts``."""
     cfg, ts = ctx.cfg, sim.ts
@@ -240,7 +136,7 @@ def _attempts(ctx: RoundContext, sim: _RoundSim, res: RoundResult) -> RoundEnd:
         seed = derive_seed(ctx.round_seed, "attempt", attempt)
         row, grasp = _plan_scene(ctx, sim, attempt, seed)
         if grasp is None:
-            res.attempts.append(row.to_dict())
+            res.attempts.append(row)
             return RoundEnd.NO_GRASP
         name = clutter_body(row.slot)
         before = {b: ts.pose_of(b)[:3, 3] for b in ts.bodies if b != name}
@@ -249,25 +145,13 @@ def _attempts(ctx: RoundContext, sim: _RoundSim, res: RoundResult) -> RoundEnd:
         t0 = time.perf_counter()
         trial_res = TrialResult(cfg.dataset.name, row.target, cfg.mode.name, cfg.rot.name, cfg.planner.name,
                                 ctx.round, seed, False, None)  # fmt: skip
-        obj = ctx.objects[row.slot]
-        tctx = TrialContext(
-            cfg,
-            obj.model,
-            obj.shape,
-            ctx.round,
-            seed,
-            ctx.recorder,
-            ctx.scene,
-            plan=ctx.plan,
-            quality=ctx.quality,
-        )
         try:
             with sim.timed("execute"):
-                _execute(tctx, sim, grasp, trial_res)
+                execute_grasp(sim, grasp, trial_res, ctx.scene)
             row.success = True
         except TrialFailed as e:
             row.reason = e.reason.value
-            sim.phase("failed", {"reason": e.reason.value, "detail": str(e), "target": name})
+            sim.phase(Phase.FAILED, {"reason": e.reason.value, "detail": str(e), "target": name})
         row.slip_m, row.touched_support = trial_res.slip_m, sim.touched_support
         row.touched_neighbours = sorted(sim.touched - {name})
         sim.release_gripper()
@@ -275,9 +159,10 @@ def _attempts(ctx: RoundContext, sim: _RoundSim, res: RoundResult) -> RoundEnd:
             _remove(ctx, sim, name)
             res.removed.append(name)
         sim.phase(
-            "attempt_end", {"attempt": attempt, "target": name, "success": row.success, "reason": row.reason}
+            Phase.ATTEMPT_END,
+            {"attempt": attempt, "target": name, "success": row.success, "reason": row.reason},
         )
-        _settle_all(sim)
+        settle_all(sim)
         _take_away_outside(ctx, sim)
         row.moved_neighbours = sorted(
             b
@@ -285,7 +170,7 @@ def _attempts(ctx: RoundContext, sim: _RoundSim, res: RoundResult) -> RoundEnd:
             if b in ts.bodies and np.linalg.norm(ts.pose_of(b)[:3, 3] - p) > MOVED_M
         )
         row.execute_s, row.sim_time_s = time.perf_counter() - t0, sim.t
-        res.attempts.append(row.to_dict())
+        res.attempts.append(row)
         failures = 0 if row.success else failures + 1
         attempt += 1
         if failures >= cfg.mode.max_consecutive_failures:
@@ -294,7 +179,7 @@ def _attempts(ctx: RoundContext, sim: _RoundSim, res: RoundResult) -> RoundEnd:
 
 
 def _plan_scene(
-    ctx: RoundContext, sim: _RoundSim, attempt: int, seed: int
+    ctx: RoundContext, sim: RoundSim, attempt: int, seed: int
 ) -> tuple[AttemptResult, Grasp | None]:
     """Plan the next grasp of the scene (``mode.pick_order``); the attempt's row and the grasp (None: none
     found on any object). Every object is seen at its perceived pose (``perception.noise``)."""
@@ -312,45 +197,22 @@ def _plan_scene(
         order.sort(key=lambda b: -float(seen[b][2][:, 2].max()))
     half = np.asarray(cfg.mode.workspace_half_size_m, dtype=np.float64)
     workspace_xy = np.stack([-half, half])  # about the support's centre, world x = y = 0
-    plans: list[tuple[float, int, str, Grasp]] = []
-    wall, cpu, n = 0.0, 0.0, 0
+    requests = tuple(_request(ctx, ts.table_z, seen, name, seed, view, workspace_xy) for name in order)
+    scene_req = SceneRequest(
+        requests,
+        tuple(slot_id(seen[name][0]) for name in order),
+        first_found=cfg.mode.pick_order == "top_most",
+        observation=view.observation,
+    )
     with sim.timed("plan"):
-        for rank, name in enumerate(order):
-            slot, pose, points = seen[name]
-            model = ctx.objects[slot].model
-            req = PlanRequest(
-                points=points,
-                normals=model.normals @ pose[:3, :3].T,
-                area_mask=model.area_mask,
-                object_pose=pose,
-                table_z=ts.table_z,
-                mode=PLANNING_MODE,
-                gripper=cfg.gripper,
-                planner=cfg.planner,
-                cost=cfg.cost,
-                seed=derive_seed(seed, "plan", slot),
-                support_blocks_gripper=bool(cfg.mode.support_collides_with_gripper),
-                neighbours=tuple(
-                    Neighbour(s, ctx.objects[s].model.name, p, q)
-                    for b, (s, q, p) in seen.items()
-                    if b != name
-                ),
-                observation=None
-                if view.observation is None
-                else dataclasses.replace(view.observation, target_id=slot_id(slot)),
-                workspace_xy=workspace_xy,
-            )
-            t0, c0 = time.perf_counter(), time.thread_time()
-            try:
-                grasp = ctx.plan(req).grasp
-            except NoFeasibleGrasp:
-                grasp = None
-            wall, cpu, n = wall + time.perf_counter() - t0, cpu + time.thread_time() - c0, n + 1
-            if grasp is not None:
-                cost = grasp.cost if np.isfinite(grasp.cost) else np.inf
-                plans.append((bool(grasp.extras.get("touches_neighbours", False)), cost, rank, name, grasp))
-                if cfg.mode.pick_order == "top_most":
-                    break
+        found, wall, cpu = timed(ctx.plan_scene, scene_req)
+    n = len(found.plans)
+    plans: list[tuple[bool, float, int, str, Grasp]] = []
+    for tp in found.plans:
+        grasp = tp.grasp
+        if grasp is not None:
+            cost = grasp.cost if np.isfinite(grasp.cost) else np.inf
+            plans.append((grasp.touches_neighbours, cost, tp.index, order[tp.index], grasp))
     first = seen[order[0]][0]
     row = AttemptResult(
         round=ctx.round, attempt=attempt, target=ctx.objects[first].model.name, slot=first, executed=False,
@@ -360,21 +222,59 @@ def _plan_scene(
     _pose_errors(row, view.errors.get(first))
     if not plans:
         _log_camera(ctx, sim, view, order[0], first)
-        sim.phase("plan", {"attempt": attempt, "found": False, "n_planned": n})
+        sim.phase(Phase.PLAN, {"attempt": attempt, "found": False, "n_planned": n})
         return row, None
-    *_, name, grasp = min(plans, key=lambda p: p[:3])  # a grasp clear of the neighbours first, then cost
+    *_, name, grasp = min(
+        plans, key=lambda p: p[:3]
+    )  # a grasp clear of the neighbours first, then cost, order
     slot = seen[name][0]
     _log_camera(ctx, sim, view, name, slot)
     row.target, row.slot, row.executed, row.reason = ctx.objects[slot].model.name, slot, True, None
     row.grasp_cost, row.grasp_width_m, row.n_feasible = grasp.cost, grasp.width_m, grasp.n_feasible
     _pose_errors(row, view.errors.get(slot))
-    sim.phase("plan", {"attempt": attempt, "target": name, "object": row.target, "n_planned": n,
+    sim.phase(Phase.PLAN, {"attempt": attempt, "target": name, "object": row.target, "n_planned": n,
                        "pick_order": cfg.mode.pick_order, "plan_s": wall})  # fmt: skip
-    ctx.recorder.grasp(sim.log_t, {**_grasp_record(grasp), "target": name})
+    ctx.recorder.grasp(sim.log_t, {**grasp_record(grasp), "target": name})
     return row, grasp
 
 
-def _log_camera(ctx: RoundContext, sim: _RoundSim, view: ScenePerceived, name: str, slot: int) -> None:
+def _request(
+    ctx: RoundContext,
+    table_z: float,
+    seen: dict[str, tuple[int, np.ndarray, np.ndarray]],
+    name: str,
+    seed: int,
+    view: ScenePerceived,
+    workspace_xy: np.ndarray,
+) -> PlanRequest:
+    """The plan request for body ``name`` of the scene ``seen`` (body -> (slot, perceived (4, 4) pose, (N, 3)
+    world cloud)): the others are its neighbours, the camera's observation names it the target."""
+    cfg = ctx.cfg
+    slot, pose, points = seen[name]
+    model = ctx.objects[slot].model
+    return PlanRequest(
+        points=points,
+        normals=model.normals @ pose[:3, :3].T,
+        area_mask=model.area_mask,
+        object_pose=pose,
+        table_z=table_z,
+        mode=PLANNING_MODE,
+        gripper=cfg.gripper,
+        planner=cfg.planner,
+        cost=cfg.cost,
+        seed=derive_seed(seed, "plan", slot),
+        support_blocks_gripper=bool(cfg.mode.support_collides_with_gripper),
+        neighbours=tuple(
+            Neighbour(s, ctx.objects[s].model.name, p, q) for b, (s, q, p) in seen.items() if b != name
+        ),
+        observation=None
+        if view.observation is None
+        else dataclasses.replace(view.observation, target_id=slot_id(slot)),
+        workspace_xy=workspace_xy,
+    )
+
+
+def _log_camera(ctx: RoundContext, sim: RoundSim, view: ScenePerceived, name: str, slot: int) -> None:
     """What the camera saw before the attempt, into the round log as a trial logs it: the views' frames
     on /tf, depth and id images, the observed cloud, and on /perception the poses of the attempt's target
     ``name`` (the object of ``slot``; the first planned when none was found): true, prior, registered."""

@@ -12,13 +12,11 @@ import numpy as np
 import sapien
 
 from graspexp.config import ModeConfig, SimConfig
-from graspexp.core.bodies import GROUND_NAME, OBJECT_NAME, SUPPORT_NAME
+from graspexp.core.bodies import FLOOR_HALF_SIZE_M, GROUND_NAME, OBJECT_NAME, SUPPORT_NAME
 from graspexp.core.geometry import matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from graspexp.sim.shape import CollisionShape
 
 OBJECT_BIT, SUPPORT_BIT, GRIPPER_BIT, GROUND_BIT = 1, 2, 4, 8
-FLOOR_HALF_SIZE_M = (10.0, 10.0, 0.05)
-"""Half extents of the floor box whose top is z = 0, m (wide enough to catch anything that falls off)."""
 
 
 def configure_physx(cfg: SimConfig) -> None:

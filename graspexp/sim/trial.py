@@ -27,14 +27,15 @@ from graspexp.core.geometry import (
     yaw_rotation,
 )
 from graspexp.core.outcome import FailureReason, TrialResult
+from graspexp.core.phases import Phase
 from graspexp.core.seeding import plan_seed, rng_for
 from graspexp.datasets.model import ObjectModel
 from graspexp.perception import Observation
+from graspexp.perception.scene_view import Perceived, perceive
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.request import PlanRequest, PlanResult
 from graspexp.sim.contacts import SupportTouch, contact_records, finger_forces
 from graspexp.sim.gripper import Gripper, build_gripper
-from graspexp.sim.perceive import Perceived, perceive
 from graspexp.sim.scene import TrialScene, build_scene
 
 
@@ -154,7 +155,7 @@ components (at most about 4 x 2^-24 = 2.4e-7 for nonnegative terms). A float64 s
 this is below it in float32 too, so only a speed near a limit needs the float32 products."""
 
 
-class _Sim:
+class TrialSim:
     """Steps one trial's scene, keeps sim time, checks stability and table touches, logs at a fixed rate.
 
     Between log ticks a step does only the physics step, the arm's drive targets computed before the run
@@ -188,7 +189,7 @@ class _Sim:
         self._next_log = self.log_every if self.recording else -1
         self._physx_step = ts.scene.physx_system.step
         self._contacts = ts.scene.physx_system.get_contacts
-        body = ts.object_body  # None in a clutter scene before its first object (clutter._RoundSim.track)
+        body = ts.object_body  # None in a clutter scene before its first object (clutter.RoundSim.track)
         self._velocities = None if body is None else (body.get_linear_velocity, body.get_angular_velocity)
         self._last_velocities: tuple[np.ndarray, np.ndarray] | None = None
         self._surely_v = self.max_speed_sq * (1.0 - F32_DOT_REL_ERROR)
@@ -301,13 +302,14 @@ class _Sim:
         finally:
             self.timings[name] += time.perf_counter() - t0 - (self.timings["log"] - log0)
 
-    def phase(self, name: str, info: dict | None = None) -> None:
+    def phase(self, phase: Phase, info: dict | None = None) -> None:
+        """Log the start of ``phase`` (with ``info``) at the current sim time."""
         t0 = time.perf_counter()
-        self.rec.phase(self.log_t, name, info or {})
+        self.rec.phase(self.log_t, phase.value, info or {})
         self.timings["log"] += time.perf_counter() - t0
 
 
-def _settle(sim: _Sim) -> tuple[bool, bool]:
+def _settle(sim: TrialSim) -> tuple[bool, bool]:
     """Step until the object rests (below both settle speeds for ``settle_hold_s``), falls below the
     support, or the time cap ``settle_max_s``; (on the support, at rest: False when the cap ran out first)."""
     cfg = sim.cfg.sim
@@ -337,7 +339,7 @@ def _on_support(ts: TrialScene, cfg: JobConfig) -> bool:
     return bool(lo[2] > ts.table_z - tolerance and abs(com[0]) <= hx and abs(com[1]) <= hy)
 
 
-def _check_gripper_stable(sim: _Sim, gripper: Gripper) -> None:
+def _check_gripper_stable(sim: TrialSim, gripper: Gripper) -> None:
     """Raise SIM_UNSTABLE when a gripper link's pose is not finite or it moves faster than
     ``sim.max_speed_mps``: a failure to hold that the physics, not the grasp, caused (an extreme setting)."""
     for link in (gripper.palm, *gripper.fingers):
@@ -349,7 +351,7 @@ def _check_gripper_stable(sim: _Sim, gripper: Gripper) -> None:
             )
 
 
-def _grasp_record(grasp: Grasp) -> dict:
+def grasp_record(grasp: Grasp) -> dict:
     return {
         "pose": grasp.pose.tolist(),
         "width_m": grasp.width_m,
@@ -358,6 +360,7 @@ def _grasp_record(grasp: Grasp) -> dict:
         "path": grasp.path,
         "planner": grasp.planner,
         "n_feasible": grasp.n_feasible,
+        "touches_neighbours": grasp.touches_neighbours,
         "approach": grasp.approach.tolist(),
         **{k: v for k, v in grasp.extras.items() if isinstance(v, (int, float, str))},
     }
@@ -378,7 +381,7 @@ def run_trial(ctx: TrialContext) -> TrialResult:
         reason=None,
     )
     timings = dict.fromkeys(("build", "settle", "plan", "quality", "execute", "log", "physics"), 0.0)
-    sim: _Sim | None = None
+    sim: TrialSim | None = None
     try:
         sim = _drop_until_on_support(ctx, res, timings)
         if not res.at_rest:
@@ -389,12 +392,12 @@ def run_trial(ctx: TrialContext) -> TrialResult:
         with sim.timed("quality"):
             res.fc_min_mu = _force_closure_mu(ctx, sim, grasp)
         with sim.timed("execute"):
-            _execute(ctx, sim, grasp, res)
+            execute_grasp(sim, grasp, res, ctx.scene)
         res.success = True
     except TrialFailed as e:
         res.reason = e.reason.value
         if sim is not None:
-            sim.phase("failed", {"reason": e.reason.value, "detail": str(e)})
+            sim.phase(Phase.FAILED, {"reason": e.reason.value, "detail": str(e)})
     if sim is not None:
         res.touched_support = sim.touched_support
         res.sim_time_s, res.steps = sim.t, sim.steps
@@ -403,7 +406,7 @@ def run_trial(ctx: TrialContext) -> TrialResult:
     return res
 
 
-def _drop_until_on_support(ctx: TrialContext, res: TrialResult, timings: dict) -> _Sim:
+def _drop_until_on_support(ctx: TrialContext, res: TrialResult, timings: dict) -> TrialSim:
     cfg = ctx.cfg
     log_offset_s = 0.0
     for attempt in range(cfg.sim.max_redrops + 1):
@@ -412,16 +415,16 @@ def _drop_until_on_support(ctx: TrialContext, res: TrialResult, timings: dict) -
         pose = drop_pose(ctx.model, cfg.rot.name, cfg.mode.support_height_m, cfg.rot.drop_height_m, rng)
         ts = build_scene(ctx.hulls, ctx.model.mass_kg, pose, cfg.mode, cfg.sim, ctx.model.friction)
         timings["build"] += time.perf_counter() - t0
-        sim = _Sim(ts, cfg, ctx.recorder, timings, log_offset_s)
+        sim = TrialSim(ts, cfg, ctx.recorder, timings, log_offset_s)
         if attempt == 0 and ctx.scene is not None:
             ctx.recorder.scene(0.0, ctx.scene.static)
-        sim.phase("drop", {"attempt": attempt})
+        sim.phase(Phase.DROP, {"attempt": attempt})
         with sim.timed("settle"):
             on_support, at_rest = _settle(sim)
         if on_support:
             res.at_rest = at_rest
             if at_rest:
-                sim.phase("settled", {"redrops": attempt})
+                sim.phase(Phase.SETTLED, {"redrops": attempt})
             else:  # never planned on a moving object: a failure class of its own
                 speed, spin = (float(v) ** 0.5 for v in sim.speed_sq)
                 info = {
@@ -430,14 +433,14 @@ def _drop_until_on_support(ctx: TrialContext, res: TrialResult, timings: dict) -
                     "angular_radps": spin,
                     "cap_s": cfg.sim.settle_max_s,
                 }
-                sim.phase("settle_timeout", info)
+                sim.phase(Phase.SETTLE_TIMEOUT, info)
             return sim
         res.redrops = attempt + 1
         log_offset_s = sim.log_t + sim.dt
     raise TrialFailed(FailureReason.FELL_OFF_SUPPORT, f"{cfg.sim.max_redrops + 1} drops fell off the support")
 
 
-def _plan(ctx: TrialContext, sim: _Sim, res: TrialResult) -> Grasp:
+def _plan(ctx: TrialContext, sim: TrialSim, res: TrialResult) -> Grasp:
     cfg = ctx.cfg
     true_pose = sim.ts.object_pose()
     seen = perceive(cfg, ctx.model, true_pose, sim.ts.table_z, ctx.trial_seed)
@@ -461,13 +464,13 @@ def _plan(ctx: TrialContext, sim: _Sim, res: TrialResult) -> Grasp:
         grasp = ctx.plan(req).grasp
     except NoFeasibleGrasp as e:
         raise TrialFailed(FailureReason.NO_FEASIBLE_GRASP, str(e)) from None
-    sim.phase("plan")
-    ctx.recorder.grasp(sim.log_t, _grasp_record(grasp))
+    sim.phase(Phase.PLAN)
+    ctx.recorder.grasp(sim.log_t, grasp_record(grasp))
     return grasp
 
 
 def _record_perception(
-    ctx: TrialContext, sim: _Sim, res: TrialResult, seen: Perceived, true_pose: np.ndarray
+    ctx: TrialContext, sim: TrialSim, res: TrialResult, seen: Perceived, true_pose: np.ndarray
 ) -> None:
     """The camera's frames, cloud and poses into the log; the pose errors and timings into the result."""
     reg = seen.registration
@@ -491,18 +494,18 @@ def _record_perception(
         ctx.recorder.perception(sim.log_t, seen.observation, poses, info)
 
 
-def _force_closure_mu(ctx: TrialContext, sim: _Sim, grasp: Grasp) -> float:
+def _force_closure_mu(ctx: TrialContext, sim: TrialSim, grasp: Grasp) -> float:
     """Force-closure friction of the planned grasp on the object's true pose (the grasp is moved into the
     object frame, so the mesh's ray-cast index is built once per object, not per trial); logged on /grasp."""
     T = sim.ts.object_pose()
     in_object = dataclasses.replace(grasp, pose=np.linalg.inv(T) @ grasp.pose)
     mu = ctx.quality(ctx.model.mesh, in_object)
     mu = mu if np.isfinite(mu) else float("nan")
-    ctx.recorder.phase(sim.log_t, "quality", {"fc_min_mu": mu})
+    ctx.recorder.phase(sim.log_t, Phase.QUALITY.value, {"fc_min_mu": mu})
     return mu
 
 
-def _held(sim: _Sim, grasp: Grasp) -> dict[str, float]:
+def _held(sim: TrialSim, grasp: Grasp) -> dict[str, float]:
     target = sim.ts.object_entity.name
     return finger_forces(sim.ts.scene.get_contacts(), sim.dt, grasp.pose[:3, 1], target)
 
@@ -518,53 +521,57 @@ def _along_z(z: np.ndarray) -> np.ndarray:
     return np.stack([np.zeros_like(z), np.zeros_like(z), z], axis=1)
 
 
-def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> None:
-    cfg = ctx.cfg
+def execute_grasp(sim: TrialSim, grasp: Grasp, res: TrialResult, scene: object | None = None) -> None:
+    """Execute ``grasp`` on the scene's target (``sim.ts.object_body``) as the mode's protocol does: approach,
+    close, (remove the support,) pull back, lift, hold; the slip and finger forces into ``res``. Raises
+    :class:`TrialFailed` with the reason when the grasp does not hold. ``scene``: the Foxglove scene whose
+    gripper entities the log gains (None: none)."""
+    cfg = sim.cfg
     mode, scfg = cfg.mode, cfg.sim
     ts = sim.ts
     gripper = build_gripper(ts.scene, cfg.gripper, grasp.pose, mode.support_collides_with_gripper)
     sim.gripper = gripper
-    if ctx.scene is not None:
-        ctx.recorder.scene(sim.log_t, ctx.scene.gripper)
+    if scene is not None:
+        sim.rec.scene(sim.log_t, scene.gripper)
     if mode.support_collides_with_gripper:
         sim.watch_support(gripper)
     standoff = float(cfg.planner.sphere_radius_m)
     half = grasp.width_m / 2
     gripper.set_state(np.array([0.0, 0.0, -standoff]), half)
 
-    sim.phase("approach", {"standoff_m": standoff, "width_m": grasp.width_m})
+    sim.phase(Phase.APPROACH, {"standoff_m": standoff, "width_m": grasp.width_m})
     sim.run(standoff / scfg.approach_speed_mps, lambda s: _along_z(-standoff * (1 - s)))
     if scfg.approach_settle_s > 0:
-        sim.phase("settle_arm", {"duration_s": scfg.approach_settle_s})
+        sim.phase(Phase.SETTLE_ARM, {"duration_s": scfg.approach_settle_s})
         sim.run(scfg.approach_settle_s)  # the arm reaches the grasp pose before the fingers close
-    sim.phase("close")
+    sim.phase(Phase.CLOSE)
     gripper.close()
     sim.run(scfg.close_s)
     forces = _held(sim, grasp)
-    if min(forces.values()) < ctx.cfg.sim.min_finger_force_n:
+    if min(forces.values()) < scfg.min_finger_force_n:
         res.finger_force_n = [forces[n] for n in FINGER_NAMES]
         _check_gripper_stable(sim, gripper)
         raise TrialFailed(FailureReason.NO_CONTACT, f"finger forces after closing {forces} N")
 
     grip0 = _grasp_point_on_object(gripper, ts)
     if mode.remove_support_after_grasp:
-        sim.phase("remove_support")
+        sim.phase(Phase.REMOVE_SUPPORT)
         ts.remove_support()
-        ctx.recorder.delete_entities(sim.log_t, [SUPPORT_NAME])
+        sim.rec.delete_entities(sim.log_t, [SUPPORT_NAME])
     if mode.pull_back_m > 0:
-        sim.phase("pull_back", {"distance_m": mode.pull_back_m})
+        sim.phase(Phase.PULL_BACK, {"distance_m": mode.pull_back_m})
         sim.run(mode.pull_back_m / scfg.retract_speed_mps, lambda s: _along_z(-mode.pull_back_m * s))
     if mode.lift_m > 0:
-        sim.phase("lift", {"distance_m": mode.lift_m})
+        sim.phase(Phase.LIFT, {"distance_m": mode.lift_m})
         start = np.array([0.0, 0.0, -mode.pull_back_m])
         up = grasp.pose[:3, :3].T @ np.array([0.0, 0.0, mode.lift_m])
         sim.run(mode.lift_m / scfg.retract_speed_mps, lambda s: start + s[:, None] * up)
-    sim.phase("hold", {"duration_s": mode.hold_s})
+    sim.phase(Phase.HOLD, {"duration_s": mode.hold_s})
     sim.run(mode.hold_s)
     forces = _held(sim, grasp)
     res.finger_force_n = [forces[n] for n in FINGER_NAMES]
     res.slip_m = float(np.linalg.norm(_grasp_point_on_object(gripper, ts) - grip0))
-    n_touching = sum(f >= ctx.cfg.sim.min_finger_force_n for f in forces.values())
+    n_touching = sum(f >= scfg.min_finger_force_n for f in forces.values())
     if n_touching < len(forces):  # paper IV-C: success = the object is still held by the gripper
         _check_gripper_stable(sim, gripper)
         raise TrialFailed(
@@ -577,4 +584,4 @@ def _execute(ctx: TrialContext, sim: _Sim, grasp: Grasp, res: TrialResult) -> No
         raise TrialFailed(
             FailureReason.SLIPPED, f"slip {res.slip_m:.4f} m > sim.slip_threshold_m = {limit} m"
         )
-    sim.phase("done", {"slip_m": res.slip_m})
+    sim.phase(Phase.DONE, {"slip_m": res.slip_m})

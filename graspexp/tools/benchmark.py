@@ -40,9 +40,9 @@ import yaml
 from omegaconf import OmegaConf
 
 from graspexp.config import ConfigError, PluginError
-from graspexp.config.mode import CLUTTER_MODES
 from graspexp.config.plugins import get_plugin
 from graspexp.run.benchmark import Benchmark, jobs, run_all, write_summary
+from graspexp.run.job_config import clutter_modes
 from graspexp.run.suites import PAPER_MODES, PAPER_ROTS
 from graspexp.tools.cli import compose_checked, fail, positive_int, tool_parser
 
@@ -100,10 +100,10 @@ def parse_args(argv: list[str]) -> Benchmark:
     if "planner" not in values:
         raise ConfigError("planner is missing: python -m graspexp benchmark planner=NAME [dataset=...]")
     modes, rots = values.pop("mode", None), values.pop("rot", None)
-    clutter = [m for m in modes or [] if m in CLUTTER_MODES]
+    clutter = [m for m in modes or [] if m in clutter_modes()]
     if clutter and len(clutter) < len(modes):
         raise ConfigError(
-            f"mode={','.join(modes)}: the clutter modes ({', '.join(CLUTTER_MODES)}) rank on rounds (DR, GSR), "
+            f"mode={','.join(modes)}: the clutter modes ({', '.join(clutter_modes())}) rank on rounds (DR, GSR), "
             "the others on trials; benchmark them in two commands"
         )
     if clutter:  # the drop rotation is not read by the clutter modes: one job per scene

@@ -2,9 +2,12 @@
 
 Usage::
 
-    python -m graspexp download_checkpoint vgn [--dir DIR] [--url URL]
+    python -m graspexp download_checkpoint NAME [--dir DIR] [--url URL]    # e.g. vgn
 
-The file lands in ``DIR``, else ``$GRASPEXP_CHECKPOINTS``, else ``~/.cache/graspexp/checkpoints`` (where the
+NAME is one of graspexp's checkpoints or one that an installed learned planner's plugin names
+(:attr:`graspexp.config.plugins.Learned.checkpoints`).
+
+The file lands in ``DIR``, else ``$GRASPEXP_CHECKPOINTS`` (its first folder), else ``~/.cache/graspexp/checkpoints`` (where the
 learned planners look for it, :mod:`graspexp.core.checkpoints`). It comes from its published address (a
 fixed commit of the authors' repository; ``--url`` for a mirror) through the project's downloader (pooch)
 and is kept only if its SHA-256 is the published one; a file already there with that hash is not fetched
@@ -17,7 +20,14 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from graspexp.core.checkpoints import CHECKPOINTS, CHECKPOINTS_ENV, checkpoint_dir
+from graspexp.config.plugins import learned_planners
+from graspexp.core.checkpoints import (
+    CHECKPOINTS,
+    CHECKPOINTS_ENV,
+    Checkpoint,
+    checkpoint_dir,
+    checkpoint_dirs,
+)
 from graspexp.datasets.download import fetch
 from graspexp.datasets.errors import DatasetError
 from graspexp.tools.cli import tool_parser
@@ -25,15 +35,25 @@ from graspexp.tools.cli import tool_parser
 PROG = "graspexp download_checkpoint"
 
 
+def known_checkpoints() -> dict[str, Checkpoint]:
+    """graspexp's checkpoints and those the installed learned planners name
+    (:attr:`graspexp.config.plugins.Learned.checkpoints`), by name."""
+    return {
+        **CHECKPOINTS,
+        **{c.name: c for learned in learned_planners().values() for c in learned.checkpoints},
+    }
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """CLI entry point; returns the exit status (2 with one line on stderr when the download fails)."""
     parser = tool_parser(PROG, "Download and verify a published network checkpoint.")
-    parser.add_argument("name", choices=sorted(CHECKPOINTS), help="which checkpoint")
+    known = known_checkpoints()
+    parser.add_argument("name", choices=sorted(known), help="which checkpoint")
     parser.add_argument("--dir", type=Path, default=None, help=f"target folder (default: ${CHECKPOINTS_ENV})")
     parser.add_argument("--url", default=None, help="address of the file (a mirror; default: published)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
-    ckpt = CHECKPOINTS[args.name]
+    ckpt = known[args.name]
     folder = (args.dir or checkpoint_dir()).expanduser()
     try:
         path = fetch(args.url or ckpt.url, folder, ckpt.filename, ckpt.sha256, progress=not args.quiet)
@@ -42,7 +62,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     print(f"{ckpt.filename} ready at {path} (SHA-256 {ckpt.sha256} verified)")
     print(f"weights: {ckpt.source}; licence: {ckpt.licence}")
-    if args.dir is not None and folder.resolve() != checkpoint_dir().resolve():
+    if args.dir is not None and folder.resolve() not in {d.resolve() for d in checkpoint_dirs()}:
         print(f"use it with {CHECKPOINTS_ENV}={folder}")
     return 0
 

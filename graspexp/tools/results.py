@@ -1,4 +1,4 @@
-"""``python -m graspexp results [--check | --stamp-cpu] [--pages a,b] [--out OUT] [--root DIR] [--n-jobs N] [key=value ...]``:
+"""``python -m graspexp results [--check | --stamp-cpu] [--pages a,b | --learned-planners] [--out OUT] [--root DIR] [--n-jobs N] [key=value ...]``:
 regenerate every results page (``docs/results/*.md`` and the README's results table) from runs of the
 current code, or with ``--check`` list the pages whose fingerprint the current code does not reproduce.
 A fingerprint holds bit for bit on one CPU class (``x86_64-v3``: AVX2; ``x86_64-v4``: AVX-512): ``--check``
@@ -9,7 +9,8 @@ Each page's sweeps run as Hydra multiruns (joblib launcher) into ``OUT/runs/`` (
 ``outputs/results/<commit>``); running the command again continues an interrupted regeneration.
 ``key=value`` overrides go to every sweep, e.g. ``hydra/launcher=submitit_slurm
 hydra.launcher.partition=P`` (SLURM) or ``hydra.launcher.n_jobs=4``. The pages are
-:data:`graspexp.run.result_pages.PAGES`. Exit status: 0; 1 when a sweep failed or (``--check``) a page is
+:func:`graspexp.run.result_pages.pages`; ``--learned-planners`` selects those that run a learned planner
+(``nox -s learned`` checks them). Exit status: 0; 1 when a sweep failed or (``--check``) a page is
 not current; 2 on a bad option.
 """
 
@@ -18,8 +19,8 @@ import sys
 from pathlib import Path
 
 from graspexp.report.pages import PageError
-from graspexp.run.result_pages import PAGES
-from graspexp.run.results import ResultsError, check, commit_of, regenerate, stamp_cpu
+from graspexp.run.result_pages import pages as result_pages
+from graspexp.run.results import ResultsError, check, commit_of, learned_pages, regenerate, stamp_cpu
 from graspexp.tools.cli import fail, positive_int, tool_parser
 
 PROG = "graspexp results"
@@ -27,6 +28,7 @@ PROG = "graspexp results"
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
+    every = result_pages()
     ap = tool_parser(PROG, __doc__.splitlines()[1], overrides=True)
     ap.add_argument(
         "--check", action="store_true", help="re-run the fingerprints; list the pages not current"
@@ -38,7 +40,12 @@ def main(argv: list[str] | None = None) -> int:
         "those pages are current)",
     )
     ap.add_argument(
-        "--pages", default="", help=f"comma-separated (default all: {', '.join(p.name for p in PAGES)})"
+        "--pages", default="", help=f"comma-separated (default all: {', '.join(p.name for p in every)})"
+    )
+    ap.add_argument(
+        "--learned-planners",
+        action="store_true",
+        help="only the pages that run a learned planner (with --pages: those of them)",
     )
     ap.add_argument("--out", type=Path, default=None, help="run folder (default outputs/results/<commit>)")
     ap.add_argument(
@@ -47,10 +54,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--n-jobs", type=positive_int, default=2, help="processes for the fingerprint jobs")
     args = ap.parse_intermixed_args(argv)
     names = [n for n in args.pages.split(",") if n]
-    unknown = [n for n in names if n not in {p.name for p in PAGES}]
+    unknown = [n for n in names if n not in {p.name for p in every}]
     if unknown:
-        fail(f"unknown page(s) {unknown}; the pages are {', '.join(p.name for p in PAGES)}", PROG)
-    pages = [p for p in PAGES if not names or p.name in names]
+        fail(f"unknown page(s) {unknown}; the pages are {', '.join(p.name for p in every)}", PROG)
+    pages = [p for p in every if not names or p.name in names]
+    if args.learned_planners:
+        pages = learned_pages(pages)
     out = args.out if args.out is not None else Path("outputs/results") / commit_of(args.root)[0]
     command = shlex.join(["python", "-m", "graspexp", "results", *argv])
     try:

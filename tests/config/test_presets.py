@@ -10,7 +10,7 @@ import yaml
 
 from graspexp.config.job import JobConfig
 from graspexp.config.plugins import get_plugin
-from graspexp.config.registry import CONF_DIR, NESTED_SCHEMAS, SCHEMAS
+from graspexp.config.registry import CONF_DIR, NESTED_SCHEMAS, SCHEMAS, SUBSCHEMAS
 
 CONF = Path(CONF_DIR)
 HYDRA_OWN = "hydra"
@@ -21,16 +21,30 @@ def _presets() -> list[Path]:
     return sorted(p for p in CONF.rglob("*.yaml") if p.relative_to(CONF).parts[0] != HYDRA_OWN)
 
 
-def _schema(path: Path, data: dict) -> type:
-    """The schema that the option's defaults list names (``/schema_<group>@_here_``,
-    ``/schema_planner_<name>@_here_``; ``schema_job`` for ``config.yaml``)."""
-    (first, *_) = data["defaults"]
-    name = first.split("@")[0].lstrip("/")
+def _schema(name: str) -> type:
+    """The schema stored as ``name`` (``schema_job``, ``schema_<group>``, ``schema_planner_<name>``)."""
     if name == "schema_job":
         return JobConfig
     if name.startswith("schema_planner_"):
         return get_plugin(name.removeprefix("schema_planner_")).plugin.config
-    return {**SCHEMAS, **NESTED_SCHEMAS}[name.removeprefix("schema_")]
+    subschemas = {k: schema for k, (_, schema) in SUBSCHEMAS.items()}
+    return {**SCHEMAS, **NESTED_SCHEMAS, **subschemas}[name.removeprefix("schema_")]
+
+
+def _nodes(data: dict) -> list[tuple[str, dict, type]]:
+    """(key, values, schema) of each node of an option that its defaults list types: ``/<schema>@_here_``
+    types the option's own keys, ``/<schema>@<key>`` its node ``key`` (a ``# @package perception`` camera
+    preset: ``camera`` and ``depth_noise``)."""
+    out = []
+    for entry in data["defaults"]:
+        name, _, at = entry.partition("@") if isinstance(entry, str) else ("", "", "")
+        if not name.lstrip("/").startswith("schema_"):
+            continue
+        if at in ("", "_here_"):
+            out.append(("", {k: v for k, v in data.items() if k != "defaults"}, _schema(name.lstrip("/"))))
+        else:
+            out.append((f"{at}.", data.get(at) or {}, _schema(name.lstrip("/"))))
+    return out
 
 
 def _default(field: dataclasses.Field) -> object:
@@ -51,12 +65,15 @@ def _same(value: object, default: object) -> bool:
 def repeated_defaults(path: Path) -> list[str]:
     """``key: value`` of every value of the YAML option ``path`` that equals its schema's default."""
     data = yaml.safe_load(path.read_text())
-    fields = {f.name: f for f in dataclasses.fields(_schema(path, data))}
-    return [
-        f"{key}: {value!r}"
-        for key, value in data.items()
-        if key in fields and key != "defaults" and _same(value, _default(fields[key]))
-    ]
+    out = []
+    for prefix, values, schema in _nodes(data):
+        fields = {f.name: f for f in dataclasses.fields(schema)}
+        out += [
+            f"{prefix}{key}: {value!r}"
+            for key, value in values.items()
+            if key in fields and _same(value, _default(fields[key]))
+        ]
+    return out
 
 
 @pytest.mark.parametrize("path", _presets(), ids=lambda p: str(p.relative_to(CONF)))
@@ -75,3 +92,9 @@ def test_the_check_finds_a_repeated_default(tmp_path):
         "defaults:\n  - /schema_planner_optimal_plus@_here_\nname: x\nm: 256\nrolls_deg: [0, 90]\n"
     )
     assert repeated_defaults(planner) == ["m: 256", "rolls_deg: [0, 90]"]
+    camera = tmp_path / "kinect.yaml"
+    camera.write_text(
+        "# @package perception\ndefaults:\n  - /schema_camera@camera\n  - /schema_depth_noise@depth_noise\n"
+        "camera:\n  name: kinect\n  width_px: 424\ndepth_noise:\n  axial_a_m: 0.002\n  edge_jump_m: 0.02\n"
+    )
+    assert repeated_defaults(camera) == ["camera.width_px: 424", "depth_noise.edge_jump_m: 0.02"]

@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from graspexp.config.perception import CameraConfig, DepthNoiseConfig, PerceptionConfig
+from graspexp.config.perception import DEPTH_NOISE_MODELS, CameraConfig, DepthNoiseConfig, PerceptionConfig
+from graspexp.perception import depth_noise
 from graspexp.perception.camera import BoxBody, MeshBody, back_project, look_at, render, view_poses
 from graspexp.perception.depth_noise import axial_sigma_m, noisy_depth
 from graspexp.perception.observe import observe
@@ -83,6 +84,23 @@ def test_grazing_pixels_and_depth_edges_lose_their_return():
     assert (depth[rows.min() + 2 : rows.max() - 1, cols.min() + 2 : cols.max() - 1] > 0).all()
     edge = box_px & ~np.roll(box_px, 1, axis=1)  # the box's left silhouette column
     assert (depth[edge] == 0).all()
+
+
+def test_the_noise_model_is_chosen_by_name(monkeypatch):
+    """``depth_noise.model`` names a registered function (every name the config accepts has one); the
+    default ``nguyen`` is :func:`graspexp.perception.depth_noise.nguyen_noise` itself."""
+    assert set(depth_noise.NOISE_MODELS) == set(DEPTH_NOISE_MODELS)
+    pose, wall = _facing_wall()
+    view = render(CAM, pose, [], [wall])
+    args = (view.depth, view.ids, view.cos_incidence)
+    direct = depth_noise.nguyen_noise(DepthNoiseConfig(), *args, rng=np.random.default_rng(1))
+    for a, b in zip(
+        noisy_depth(DepthNoiseConfig(), *args, rng=np.random.default_rng(1)), direct, strict=True
+    ):
+        np.testing.assert_array_equal(a, b)
+    monkeypatch.setitem(depth_noise.NOISE_MODELS, "flat", lambda cfg, d, i, c, *, rng: (d + 1, i))
+    depth, _ = noisy_depth(DepthNoiseConfig(model="flat"), *args, rng=np.random.default_rng(1))
+    np.testing.assert_allclose(depth, DISTANCE_M + 1)
 
 
 def test_observation_is_seeded_and_back_projects_onto_the_surface():

@@ -104,7 +104,7 @@ def test_enclosed_target_falls_back_to_its_plan_alone(planner):
     shell = shell[shell[:, 2] > TABLE_Z + 0.005]
     boxed = dataclasses.replace(req, neighbours=(Neighbour(1, "shell", shell, np.eye(4)),))
     grasp = plan(boxed).grasp
-    assert grasp.extras["touches_neighbours"]
+    assert grasp.touches_neighbours
     if planner == "optimal_plus":
         alone = plan(req).grasp
         np.testing.assert_array_equal(grasp.pose, alone.pose)

@@ -31,8 +31,9 @@ from graspexp.core import checkpoints  # noqa: E402
 from graspexp.grippers import GripperGeometry  # noqa: E402
 from graspexp.perception.camera import BoxBody, MeshBody  # noqa: E402
 from graspexp.perception.observe import observe  # noqa: E402
+from graspexp.perception.tsdf import fuse  # noqa: E402
 from graspexp.planning import PlanRequest, plan  # noqa: E402
-from graspexp.planning.learned import tsdf, vgn, vgn_network  # noqa: E402
+from graspexp.planning.learned import vgn, vgn_network  # noqa: E402
 
 pytestmark = pytest.mark.learned
 SHARED_VGN = shared_data_root().parent / "peers" / "vgn"
@@ -43,12 +44,15 @@ TABLE_Z = 0.1
 
 @pytest.fixture(autouse=True)
 def _checkpoint_dir(monkeypatch: pytest.MonkeyPatch) -> Path:
-    """The folder holding ``vgn_conv.pth`` for these tests (never a copy inside the repository)."""
-    folder = Path(os.environ.get(checkpoints.CHECKPOINTS_ENV, SHARED_VGN))
-    if not (folder / checkpoints.VGN.filename).is_file():
-        pytest.skip(f"the VGN checkpoint is not in {folder}: python -m graspexp download_checkpoint vgn")
-    monkeypatch.setenv(checkpoints.CHECKPOINTS_ENV, str(folder))
-    return folder
+    """The folder holding ``vgn_conv.pth`` for these tests (never a copy inside the repository):
+    ``$GRASPEXP_CHECKPOINTS`` (one folder or several, ``os.pathsep``), else :data:`SHARED_VGN`."""
+    monkeypatch.setenv(
+        checkpoints.CHECKPOINTS_ENV, os.environ.get(checkpoints.CHECKPOINTS_ENV, str(SHARED_VGN))
+    )
+    path = checkpoints.checkpoint_path(checkpoints.VGN)
+    if not path.is_file():
+        pytest.skip(f"the VGN checkpoint is not in {path.parent}: python -m graspexp download_checkpoint vgn")
+    return path.parent
 
 
 def _scene(size=(0.05, 0.08, 0.12), azimuths=(0.0, 120.0, 240.0), mesh=None, seed: int = 0, noise=True):
@@ -129,15 +133,14 @@ def test_the_fused_grid_is_vgns_voxel_cloud_of_open3d():
     colours) placed at floor(point / voxel)."""
     obs, _, _ = _scene(azimuths=(0.0, 180.0), noise=False)
     corner = vgn.world_from_volume(obs.points[obs.point_ids == 1], TABLE_Z)
-    views = [tsdf.DepthView(v.depth, v.K, v.world_from_camera) for v in obs.views]
-    grid = tsdf.fuse(views, corner, 0.3, 40, 2.0)
+    grid = fuse(obs.views, corner, 0.3, 40, 2.0)
     volume = o3d.pipelines.integration.UniformTSDFVolume(
         length=0.3,
         resolution=40,
         sdf_trunc=0.03,
         color_type=o3d.pipelines.integration.TSDFVolumeColorType.NoColor,
     )
-    for v in views:
+    for v in obs.views:
         rgbd = o3d.geometry.RGBDImage.create_from_color_and_depth(
             o3d.geometry.Image(np.zeros_like(v.depth)), o3d.geometry.Image(v.depth), 1.0, 2.0, False
         )
@@ -248,11 +251,11 @@ def test_a_plan_on_a_rendered_ycb_object_straddles_it(data_root):
 
 def _three_in_a_row(x0: float, y: float):
     """A clutter scene (mode=pile; a mug, a banana and a box 1 cm apart in a row along x from ``x0``, centred
-    on ``y``, m) seen by the camera (:func:`graspexp.sim.perceive.perceive_scene`): the plain config, the
-    support height, slot -> (model, pose) and the scene's view."""
+    on ``y``, m) seen by the camera (:func:`graspexp.perception.scene_view.perceive_scene`): the plain config,
+    the support height, slot -> (model, pose) and the scene's view."""
+    from graspexp.perception.scene_view import perceive_scene
     from graspexp.run.job_config import make_ready
     from graspexp.run.objects import load_sim_object
-    from graspexp.sim.perceive import perceive_scene
     from graspexp.sim.trial import plain_config
 
     cfg = compose_cfg("mode=pile", "planner=vgn", "gripper=panda", "dataset=primitives")
@@ -272,9 +275,9 @@ def _three_in_a_row(x0: float, y: float):
 
 def test_vgn_plans_each_object_of_a_three_object_pile_from_one_observation():
     """A clutter scene (mode=pile; a mug, a banana and a box 1 cm apart): the camera sees all three
-    (:func:`graspexp.sim.perceive.perceive_scene`), each request names its target, and VGN's grasp for a
-    target holds that target between its pads, the same grasp every time."""
-    from graspexp.sim.perceive import slot_id
+    (:func:`graspexp.perception.scene_view.perceive_scene`), each request names its target, and VGN's grasp
+    for a target holds that target between its pads, the same grasp every time."""
+    from graspexp.perception.scene_view import slot_id
 
     plain, table_z, objects, view = _three_in_a_row(-0.1, 0.0)
     assert set(np.unique(view.observation.point_ids)) == {0, 1, 2, 3}
@@ -294,12 +297,12 @@ def test_vgn_plans_each_object_of_a_three_object_pile_from_one_observation():
 def test_vgn_in_a_pile_infers_once_on_the_workspace_and_assigns_each_detection_to_the_object_it_holds(
     monkeypatch,
 ):
-    """A clutter request (it carries the mode's workspace): VGN's one fixed volume centred on the
-    workspace, one fusion and forward pass for every target of the scene, each detection given to the
-    object whose points it holds; every target's grasp is one of the scene's candidates assigned to it,
-    and the same computed afresh."""
-    from graspexp.planning import NoFeasibleGrasp
-    from graspexp.sim.perceive import slot_id
+    """A clutter scene (VGN's ``plan_scene``): VGN's one fixed volume centred on the workspace, one fusion
+    and forward pass for every target of the scene, each detection given to the object whose points it
+    holds; every target's grasp is one of the scene's candidates assigned to it, and the same computed
+    afresh; with ``first_found`` the targets after the first grasp are not planned."""
+    from graspexp.perception.scene_view import slot_id
+    from graspexp.planning.scene import SceneRequest
 
     plain, table_z, objects, view = _three_in_a_row(-0.08, 0.03)
     half = np.asarray(plain.mode.workspace_half_size_m, dtype=float)
@@ -308,26 +311,22 @@ def test_vgn_in_a_pile_infers_once_on_the_workspace_and_assigns_each_detection_t
     infer = vgn.infer
     monkeypatch.setattr(vgn, "infer", lambda *a, **k: calls.append(1) or infer(*a, **k))
 
-    def plan_for(slot):
+    def target(slot):
         obs = dataclasses.replace(view.observation, target_id=slot_id(slot))
-        req = dataclasses.replace(_request(obs, 7 + slot), table_z=table_z, workspace_xy=workspace)
-        try:
-            return vgn.plan_vgn(req)
-        except NoFeasibleGrasp:
-            return None
+        return dataclasses.replace(_request(obs, 7 + slot), table_z=table_z, workspace_xy=workspace)
 
-    monkeypatch.setattr(vgn, "_SCENE", None)
-    results = {slot: plan_for(slot) for slot in objects}
-    assert len(calls) == 1  # one forward pass for the three targets
-    scene, cached = vgn._scene_cached(
-        dataclasses.replace(_request(view.observation), table_z=table_z, workspace_xy=workspace)
-    )
-    assert cached and len(calls) == 1
+    scene_req = SceneRequest(tuple(target(s) for s in objects), tuple(slot_id(s) for s in objects))
+    res = vgn.plan_vgn_scene(scene_req)
+    assert len(calls) == 1 and [tp.index for tp in res.plans] == list(range(len(objects)))
+    results = dict(zip(objects, (tp.result for tp in res.plans), strict=True))
+    scene = vgn.scene_grasps(target(0), vgn.world_from_scene_volume(workspace, table_z))
     np.testing.assert_array_equal(scene.volume, vgn.world_from_scene_volume(workspace, table_z))
     np.testing.assert_allclose(scene.volume[:3, 3], [-0.15, -0.15, table_z - vgn.TABLE_IN_VOLUME_M])
     assert set(np.unique(scene.owner)) <= {0, *(slot_id(s) for s in objects)}
     found = {slot: r for slot, r in results.items() if r is not None}
     assert found, "no object of the pile got a grasp"
+    paid = [r.grasp.extras["infer_cpu_s"] > 0 for r in found.values()]
+    assert sum(paid) <= 1  # the scene's fusion and inference are in the extras of one target only
     for slot, result in found.items():
         g = result.grasp
         mine = [
@@ -337,13 +336,13 @@ def test_vgn_in_a_pile_infers_once_on_the_workspace_and_assigns_each_detection_t
         model, pose = objects[slot]
         truth = model.points @ pose[:3, :3].T + pose[:3, 3]
         assert vgn.target_points_between_pads(g.pose, g.width_m, plain.gripper, truth) > 0
-        assert g.extras["infer_cpu_s"] >= 0 and g.extras["n_detected"] == len(scene.found.quality)
-    for (
-        slot
-    ) in objects:  # no detection holds an object other than the one it is assigned to, with more points
+        assert g.extras["n_detected"] == len(scene.found.quality)
+    for slot in objects:  # a target without a grasp has no detection assigned to it
         if results[slot] is None:
             assert not (scene.owner == slot_id(slot)).any()
-    monkeypatch.setattr(vgn, "_SCENE", None)
-    for slot, result in found.items():
-        np.testing.assert_array_equal(plan_for(slot).grasp.pose, result.grasp.pose)
-    assert len(calls) == 2  # computed afresh once more: the same grasps
+    again = vgn.plan_vgn_scene(scene_req)
+    for slot, tp in zip(objects, again.plans, strict=True):
+        if slot in found:
+            np.testing.assert_array_equal(tp.grasp.pose, found[slot].grasp.pose)
+    first = vgn.plan_vgn_scene(dataclasses.replace(scene_req, first_found=True))
+    assert first.plans[-1].result is not None and all(tp.result is None for tp in first.plans[:-1])

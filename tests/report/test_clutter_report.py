@@ -14,7 +14,7 @@ def _attempt(r, i, success, reason=None, executed=True, plan_cpu_s=0.004):
     return AttemptResult(
         round=r, attempt=i, target="can", slot=i, executed=executed, success=success, reason=reason,
         pick_order="lowest_cost", n_left=3 - i, n_planned=3 - i, plan_s=2 * plan_cpu_s, plan_cpu_s=plan_cpu_s,
-    ).to_dict()  # fmt: skip
+    )  # fmt: skip
 
 
 def _rounds():

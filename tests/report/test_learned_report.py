@@ -3,7 +3,7 @@ object, failures by reason) and the camera page's pooled table, on synthetic tri
 
 import pandas as pd
 
-from graspexp.report.camera import LEARNED_COLUMNS, pooled_table
+from graspexp.report.camera import learned_columns, pooled_table
 from graspexp.report.learned import failure_counts, object_rates, setting_rates
 
 
@@ -39,7 +39,7 @@ def test_the_camera_pages_pooled_table_has_the_vgn_column():
     results = pd.concat(
         [_trials("optimal", 9, "dropped"), _trials("vgn", 5, "no_contact")], ignore_index=True
     )
-    pooled = pooled_table(results, (("optimal", False, "optimal, exact pose"), *LEARNED_COLUMNS))
+    pooled = pooled_table(results, (("optimal", False, "optimal, exact pose"), *learned_columns()))
     pooled = pooled.set_index("column")
     assert pooled.loc["optimal, exact pose", "trials"] == 40
     assert pooled.loc["vgn, gripper=panda, camera views", "success %"] == "50.0 (35.2-64.8)"

@@ -15,12 +15,12 @@ from graspexp.core.seeding import round_seed
 from graspexp.planning import plan
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.request import PlanResult
-from graspexp.quality import fc_min_mu
+from graspexp.planning.scene import per_object
 from graspexp.run.job_config import make_ready
-from graspexp.run.objects import load_sim_object
+from graspexp.run.objects import load_sim_object, round_context
 from graspexp.run.round_loop import draw_objects
-from graspexp.sim.clutter_scene import add_clutter_object, clutter_scene
-from graspexp.sim.rounds import RoundContext, RoundObject, run_round
+from graspexp.sim.round_scene import add_clutter_object, clutter_scene
+from graspexp.sim.rounds import run_round
 from graspexp.sim.trial import plain_config
 
 
@@ -31,14 +31,7 @@ def _round(mode: str, objects: list[str], plan_fn=plan, r: int = 0, *overrides: 
     make_ready(cfg)
     plain = plain_config(cfg)
     loaded = [load_sim_object(cfg, name, plain) for name in objects]
-    ctx = RoundContext(
-        plain,
-        [RoundObject(o.model, o.hulls) for o in loaded],
-        r,
-        round_seed(plain, r),
-        plan=plan_fn,
-        quality=fc_min_mu,
-    )
+    ctx = round_context(plain, loaded, r, round_seed(plain, r), planner=per_object(plan_fn))
     return run_round(ctx)
 
 
@@ -68,21 +61,21 @@ def test_the_round_ends_when_the_planner_finds_no_grasp():
     res = _round("packed", ["can", "box"], _no_grasp)
     assert res.end == RoundEnd.NO_GRASP.value and res.removed == []
     (row,) = res.attempts
-    assert not row["executed"] and row["reason"] == "no_feasible_grasp"
-    assert row["n_planned"] == len(res.placed) == row["n_left"]
+    assert not row.executed and row.reason == "no_feasible_grasp"
+    assert row.n_planned == len(res.placed) == row.n_left
 
 
 @pytest.mark.parametrize("limit", [2, 3])
 def test_the_round_ends_after_the_failure_limit(limit):
     res = _round("packed", ["can", "box"], _above, 0, f"mode.max_consecutive_failures={limit}")
     assert res.end == RoundEnd.FAILURE_LIMIT.value
-    assert [a["reason"] for a in res.attempts] == ["no_contact"] * limit
-    assert all(a["executed"] for a in res.attempts)
+    assert [a.reason for a in res.attempts] == ["no_contact"] * limit
+    assert all(a.executed for a in res.attempts)
 
 
 def test_gripper_table_contact_fails_the_attempt():
     res = _round("packed", ["can"], _into_table)
-    assert res.attempts[0]["reason"] == "collision_support" and res.attempts[0]["touched_support"]
+    assert res.attempts[0].reason == "collision_support" and res.attempts[0].touched_support
     assert res.end == RoundEnd.FAILURE_LIMIT.value
 
 
@@ -90,8 +83,8 @@ def test_a_held_object_is_removed_and_the_cleared_table_ends_the_round():
     res = _round("packed", ["can", "bottle"])
     assert res.end == RoundEnd.CLEARED.value, res.attempts
     assert sorted(res.removed) == sorted(res.placed) and len(res.placed) == 2
-    assert [a["success"] for a in res.attempts] == [True, True]
-    assert res.attempts[0]["n_left"] == 2 and res.attempts[1]["n_left"] == 1
+    assert [a.success for a in res.attempts] == [True, True]
+    assert res.attempts[0].n_left == 2 and res.attempts[1].n_left == 1
 
 
 def test_a_round_rerun_alone_gives_the_same_result():
@@ -137,10 +130,10 @@ def test_a_three_object_pile_round_runs_end_to_end_resimulates_and_resumes(tmp_p
     path = tmp_path / "trials" / "pile" / "000.mcap"
     res = RoundResult.from_dict(read_round(path))
     assert sorted(res.drawn) == ["box", "can", "mug"] and res.end in {e.value for e in RoundEnd}
-    assert res.attempts and all(a["plan_s"] > 0 for a in res.attempts)
+    assert res.attempts and all(a.plan_s > 0 for a in res.attempts)
     log = read_trial(path)
     assert {f"object_{i}" for i in range(3)} <= set(log.transforms)  # every object's pose over time
-    assert len(log.grasps) == sum(a["executed"] for a in res.attempts)
+    assert len(log.grasps) == sum(a.executed for a in res.attempts)
     assert {"remove_tray", "settled", "plan", "close", "round_end"} <= {name for _, name, _ in log.phases}
     with open(path, "rb") as f:
         counts = strictly_valid(f)  # every message valid against its schema (Foxglove's and ours)
@@ -191,7 +184,7 @@ def test_a_logged_depth_round_records_what_the_camera_saw_and_resimulates(tmp_pa
 def test_a_depth_pile_round_plans_on_registered_poses_and_records_their_errors():
     """perception.source=depth in a 3-object pile: each plan request carries the camera's observation of
     the whole scene (every object's id, its own target's), and each attempt records its target's errors."""
-    from graspexp.sim.perceive import slot_id
+    from graspexp.perception.scene_view import slot_id
 
     seen = []
 
@@ -204,7 +197,7 @@ def test_a_depth_pile_round_plans_on_registered_poses_and_records_their_errors()
         "pile", ["can", "box", "mug"], capture, 0, "perception.source=depth", "perception.noise.trans_mm=10",
         "perception.noise.rot_deg=10",
     )  # fmt: skip
-    rows = res.attempt_rows()
+    rows = res.attempts
     assert res.end != RoundEnd.ERROR.value and rows, res.error
     first_ids = seen[0][1] - {0}
     assert len(first_ids) == res.n_placed  # every object placed is in the first observation
@@ -217,7 +210,7 @@ def test_a_depth_pile_round_plans_on_registered_poses_and_records_their_errors()
 
 def test_truth_rounds_record_no_pose_error():
     res = _round("packed", ["can", "box"], _no_grasp)
-    (row,) = res.attempt_rows()
+    (row,) = res.attempts
     assert np.isnan(row.pose_adds_mm) and np.isnan(row.registration_fitness)
 
 
@@ -247,7 +240,7 @@ def test_a_clutter_jobs_objective_is_its_gsr_and_zero_when_no_grasp_was_attempte
     from graspexp.run.round_loop import round_objective
 
     def rnd(*attempts):
-        return SimpleNamespace(attempts=[{"executed": e, "success": s} for e, s in attempts])
+        return SimpleNamespace(attempts=[SimpleNamespace(executed=e, success=s) for e, s in attempts])
 
     assert round_objective([rnd((True, True), (True, False)), rnd((False, False))]) == 0.5
     assert round_objective([rnd((False, False)), rnd()]) == 0.0

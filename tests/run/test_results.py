@@ -31,11 +31,13 @@ from graspexp.report.pages import (
     stamp,
 )
 from graspexp.run.provenance import cpu_class
-from graspexp.run.result_pages import PAGES
+from graspexp.run.result_pages import pages
 from graspexp.run.results import check, commit_of, fingerprint_jobs, merged, regenerate
 from graspexp.tools.results import main as results_main
 
 ROOT = Path(__file__).resolve().parents[2]
+PAGES = pages()
+"""The results pages of the planners installed here."""
 
 FAKE_PAGE = """
 from graspexp.run.results import Page, Sweep
@@ -255,7 +257,7 @@ def test_a_page_whose_planner_cannot_run_here_is_skipped_with_one_line(monkeypat
 
 
 def test_every_results_page_is_generated_but_the_labelled_experiments():
-    """Every page under docs/results/ is a :data:`PAGES` entry (``python -m graspexp results`` rewrites
+    """Every page under docs/results/ is a :func:`pages` entry (``python -m graspexp results`` rewrites
     it), but the experiments page (before/after studies, each naming its commits)."""
     pages = {str(p.relative_to(ROOT)) for p in (ROOT / "docs" / "results").rglob("*.md")}
     assert pages - {p.path for p in PAGES} == {"docs/results/experiments.md"}

@@ -18,7 +18,7 @@ import graspexp
 from graspexp.config.job import JobConfig
 from graspexp.config.plugins import LoadedPlanner, load_planners
 from graspexp.config.reference import render
-from graspexp.config.registry import SCHEMAS, group_options
+from graspexp.config.registry import SCHEMAS, SUBSCHEMAS, group_options
 
 ROOT = Path(graspexp.__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
@@ -46,6 +46,7 @@ def _planner_sections(text: str) -> dict[str, str]:
 def test_the_reference_names_every_key_of_every_group_and_planner():
     text = render()
     expected = _keys(JobConfig, "") + [k for g, s in SCHEMAS.items() for k in _keys(s, f"{g}.")]
+    expected += [k for g, s in SUBSCHEMAS.values() for k in _keys(s, f"{g}.")]
     missing = [k for k in expected if f"| `{k}` |" not in text]
     sections = _planner_sections(text)
     for name, found in load_planners().items():

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import functools
+import os
 import shutil
 import threading
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
@@ -75,3 +76,17 @@ def test_a_missing_or_resized_checkpoint_names_the_download_command(tmp_path, mo
     assert "has 22 bytes, not the published 1255822" in checkpoints.missing_reason(checkpoints.VGN)
     with pytest.raises(checkpoints.CheckpointError, match="has 22 bytes"):
         checkpoints.read_verified(checkpoints.VGN)
+
+
+def test_a_checkpoint_is_found_in_any_folder_of_the_variable(tmp_path, monkeypatch):
+    """``$GRASPEXP_CHECKPOINTS`` may name several folders (one per learned planner), searched in order; a
+    download goes to the first."""
+    first, second = tmp_path / "giga", tmp_path / "vgn"
+    second.mkdir()
+    (second / checkpoints.VGN.filename).write_bytes(b"x")
+    monkeypatch.setenv(checkpoints.CHECKPOINTS_ENV, f"{first}{os.pathsep}{second}")
+    assert checkpoints.checkpoint_dirs() == [first, second] and checkpoints.checkpoint_dir() == first
+    assert checkpoints.checkpoint_path(checkpoints.VGN) == second / checkpoints.VGN.filename
+    assert "has 1 bytes" in checkpoints.missing_reason(checkpoints.VGN)
+    monkeypatch.setenv(checkpoints.CHECKPOINTS_ENV, str(first))
+    assert checkpoints.checkpoint_path(checkpoints.VGN) == first / checkpoints.VGN.filename

@@ -113,3 +113,51 @@ def test_importing_the_planners_loads_neither_hydra_nor_sapien():
     code = "import sys, graspexp.planning; print(sorted({m.split('.')[0] for m in sys.modules} & {'hydra', 'sapien'}))"
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0 and proc.stdout.strip() == "[]", proc.stderr
+
+
+FAKE_LEARNED = """
+from graspexp.config import Learned, PlannerPlugin
+from graspexp.config.planner.base import BASE_CONSTRAINTS, PlannerConfig
+from graspexp.core.checkpoints import Checkpoint
+
+WEIGHTS = Checkpoint("fakenet_weights", "fakenet.pt", "https://example.invalid/fakenet.pt", "0" * 64, 1, "", "")
+PLUGIN = PlannerPlugin(
+    plan="fake_learned:plan",
+    config=PlannerConfig,
+    constraints=BASE_CONSTRAINTS,
+    needs_observation=True,
+    learned=Learned(gripper="robotiq_2f85", checkpoints=(WEIGHTS,)),
+)
+"""
+"""A learned planner of another package: its plugin module (nothing of graspexp edited)."""
+LEARNED_TRACE = """
+from graspexp.report.camera import learned_columns
+from graspexp.run.result_pages import pages
+from graspexp.run.results import learned_pages
+from graspexp.tools.bench.learned import bench_jobs
+from graspexp.tools.download_checkpoint import known_checkpoints
+
+found = {p.name: [s.name for s in p.sweeps] for p in pages()}
+print([c[2] for c in learned_columns()])
+print([n for n in found['camera'] + found['learned'] + found['clutter_camera'] if 'fakenet' in n])
+print([p.name for p in learned_pages(pages())])
+print(bench_jobs([])[0], 'fakenet_weights' in known_checkpoints())
+"""
+
+
+def test_a_learned_plugin_joins_the_learned_pages_through_its_entry_point_alone(tmp_path):
+    """A second learned planner is its plugin module and its entry point: the camera page's column, the
+    camera, learned and camera clutter pages' sweeps, ``nox -s learned``'s pages, ``bench.learned`` and
+    ``download_checkpoint`` take it up."""
+    env = _register(tmp_path / "site", "fakenet-planner", "0.1", {"fakenet": "fake_learned:PLUGIN"})
+    (tmp_path / "site" / "fake_learned.py").write_text(FAKE_LEARNED)
+    proc = subprocess.run(
+        [sys.executable, "-c", LEARNED_TRACE], cwd=REPO, env=env, capture_output=True, text=True, timeout=120
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.splitlines() == [
+        "['fakenet, gripper=robotiq_2f85, camera views', 'vgn, gripper=panda, camera views']",
+        "['fakenet_robotiq_2f85', 'fakenet_robotiq_2f85', 'fakenet_rg2', 'clutter_camera_fakenet']",
+        "['camera', 'learned', 'clutter_camera']",
+        "['planner=fakenet', 'gripper=robotiq_2f85', 'dataset=ycb', 'mode=bin'] True",
+    ]

@@ -40,7 +40,7 @@ class PaperPathsConfig(PlannerConfig):
     neighbour_fallback: bool = True
     """Clutter rounds: when the swept gripper of every path meets a neighbour, ``optimal`` takes the cheapest
     path clear of the target and the support, ``optimal_plus`` the grasp it plans for the target alone
-    (``extras["touches_neighbours"]``), instead of finding no grasp. The protocol lets the gripper touch
+    (``Grasp.touches_neighbours``), instead of finding no grasp. The protocol lets the gripper touch
     the other objects (VGN executes with ``allow_contact=True``); in a heap, a palm 15 cm wide meets a
     neighbour on nearly every path. No effect on one object."""
     seed: int = 0

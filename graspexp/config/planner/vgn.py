@@ -12,7 +12,7 @@ from importlib.util import find_spec
 
 from graspexp.config.constraints import Interval, Options
 from graspexp.config.planner.base import BASE_CONSTRAINTS, PlannerConfig
-from graspexp.config.plugins import PlannerPlugin
+from graspexp.config.plugins import Learned, PlannerPlugin
 from graspexp.core.checkpoints import VGN, missing_reason
 
 EXTRA_MODULES = ("torch", "open3d")
@@ -85,9 +85,11 @@ def unavailable() -> str:
 
 PLUGIN = PlannerPlugin(
     plan="graspexp.planning.learned.vgn:plan_vgn",
+    plan_scene="graspexp.planning.learned.vgn:plan_vgn_scene",
     config=VgnConfig,
     constraints=CONSTRAINTS,
     unavailable=unavailable,
     needs_observation=True,
+    learned=Learned(gripper="panda", checkpoints=(VGN,), extra="learned"),
 )
 """Entry point of ``planner=vgn`` (graspexp's ``pyproject.toml``)."""

@@ -5,14 +5,15 @@ depth views, with the network's own pre- and post-processing.
    plane (where VGN's table lay); one object: its centre above the observed target points' centroid; a
    clutter scene: VGN's one fixed volume centred on the mode's workspace, fused and inferred once per
    scene (VGN's clutter removal, ethz-asl/vgn ``experiments/clutter_removal.py``).
-2. The depth views are fused into a 40^3 TSDF (:mod:`graspexp.planning.learned.tsdf`).
+2. The depth views are fused into a 40^3 TSDF (:mod:`graspexp.perception.tsdf`).
 3. One forward pass (:mod:`graspexp.planning.learned.vgn_network`) gives per voxel a quality, a grasp
    orientation and a width.
 4. VGN's detection: the quality volume smoothed by a Gaussian, kept only near observed free space,
    widths out of range dropped, thresholded, non-maximum suppressed.
 5. Each remaining voxel is a grasp in VGN's frame, converted to graspexp's (:func:`graspexp_from_vgn`),
    and assigned to the object whose observed points it holds between its pads (the most of them); the
-   target's candidates are those assigned to it; one is chosen.
+   target's candidates are those assigned to it; one is chosen. A clutter scene is planned through
+   :func:`plan_vgn_scene` (the plugin's ``plan_scene``): one volume, one forward pass, every target.
 
 VGN's grasp frame (the authors' simulated Panda): +Z approach, +Y closing axis (the fingers at y = +-w/2),
 origin between the finger roots, the fingertips ``VGN_FINGER_DEPTH_M`` ahead along +Z; a grasp in voxel
@@ -21,6 +22,7 @@ origin between the finger roots, the fingertips ``VGN_FINGER_DEPTH_M`` ahead alo
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass
 
@@ -32,10 +34,11 @@ from scipy.spatial.transform import Rotation
 from graspexp.config import GripperConfig
 from graspexp.config.planner.vgn import VgnConfig
 from graspexp.grippers import GripperGeometry
+from graspexp.perception.tsdf import fuse
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
-from graspexp.planning.learned.tsdf import DepthView, fuse
 from graspexp.planning.learned.vgn_network import GRID, VgnNet, load_vgn
 from graspexp.planning.request import PlanRequest, PlanResult
+from graspexp.planning.scene import SceneRequest, SceneResult, TargetPlan
 
 SIZE_M = 0.3
 """Edge of VGN's workspace cube, m (6 finger depths; the network was trained on it)."""
@@ -50,15 +53,11 @@ DEPTH_MAX_M = 2.0
 INSIDE_MIN = 1e-3
 """Encoded TSDF values in (INSIDE_MIN, 0.5) are behind a surface (VGN's mask)."""
 
-_NET: VgnNet | None = None
 
-
+@functools.cache
 def network() -> VgnNet:
     """The loaded network, read and verified once per process."""
-    global _NET
-    if _NET is None:
-        _NET = load_vgn()
-    return _NET
+    return load_vgn()
 
 
 @dataclass(frozen=True)
@@ -190,8 +189,7 @@ def scene_grasps(req: PlanRequest, volume: np.ndarray) -> SceneGrasps:
     cfg: VgnConfig = req.planner
     obs = req.observation
     wall0, cpu0 = time.perf_counter(), time.process_time()
-    views = [DepthView(v.depth, v.K, v.world_from_camera) for v in obs.views]
-    grid = fuse(views, volume, SIZE_M, GRID, DEPTH_MAX_M)
+    grid = fuse(obs.views, volume, SIZE_M, GRID, DEPTH_MAX_M)
     wall1, cpu1 = time.perf_counter(), time.process_time()
     quality, rot, width = infer(network(), grid, cfg.threads)
     wall2, cpu2 = time.perf_counter(), time.process_time()
@@ -220,25 +218,6 @@ def scene_grasps(req: PlanRequest, volume: np.ndarray) -> SceneGrasps:
     return SceneGrasps(volume, grid, quality, poses, openings, found, owner, timing)
 
 
-_SCENE: tuple[tuple, SceneGrasps] | None = None
-"""The last clutter scene's candidates and what they were computed from (:func:`_scene_cached`)."""
-
-
-def _scene_cached(req: PlanRequest) -> tuple[SceneGrasps, bool]:
-    """The candidates of the clutter scene the request observes (VGN's one volume on the workspace, one
-    forward pass per scene) and whether they were computed for an earlier request: the requests of one
-    attempt share the observation's views (the same object), the planner's config, the gripper, the
-    support height and the workspace. One scene is kept (the views it holds stay alive, so identity
-    cannot be reused); the result is the same computed afresh."""
-    global _SCENE
-    key = (req.planner, req.gripper, float(req.table_z), tuple(np.asarray(req.workspace_xy).ravel()))
-    if _SCENE is not None and _SCENE[0][0] is req.observation.views and _SCENE[0][1:] == key:
-        return _SCENE[1], True
-    found = scene_grasps(req, world_from_scene_volume(req.workspace_xy, req.table_z))
-    _SCENE = ((req.observation.views, *key), found)
-    return found, False
-
-
 def _opening(cfg: VgnConfig, gripper: GripperConfig, predicted_m: float) -> float:
     if cfg.opening == "max":
         return float(gripper.max_width_m)
@@ -246,24 +225,52 @@ def _opening(cfg: VgnConfig, gripper: GripperConfig, predicted_m: float) -> floa
 
 
 def plan_vgn(req: PlanRequest) -> PlanResult:
-    """The grasp VGN detects on the target in the request's camera observation; NoFeasibleGrasp (one line)
-    when the request has no observation, the camera saw no target point, or no candidate holds it.
+    """The grasp VGN detects on the target in the request's camera observation, in a volume centred on the
+    target's observed points; NoFeasibleGrasp (one line) when the request has no observation, the camera saw
+    no target point, or no candidate holds it."""
+    target = _target_points(req)
+    return _choose(req, scene_grasps(req, world_from_volume(target, req.table_z)), paid=True)
 
-    One object: the volume is centred on the target's observed points. A clutter scene (the request
-    carries the mode's ``workspace_xy``): VGN's one fixed volume on the workspace, fused and inferred once
-    per scene (cached across the attempt's requests), each candidate assigned to the object it holds; a
-    target's candidates are those assigned to it."""
-    cfg: VgnConfig = req.planner
-    obs = getattr(req, "observation", None)
+
+def plan_vgn_scene(req: SceneRequest) -> SceneResult:
+    """VGN's clutter removal: one fixed volume on the mode's workspace, fused and inferred once for the
+    scene (at the first target the camera saw), each candidate assigned to the object it holds; a target's
+    candidates are those assigned to it. Targets in the request's order (``first_found``: up to the first
+    grasp found); the fusion's and inference's times are in the extras of the target that paid them."""
+    scene: SceneGrasps | None = None
+    plans = []
+    for i, target in enumerate(req.targets):
+        try:
+            _target_points(target)
+            paid = scene is None
+            if scene is None:
+                scene = scene_grasps(target, world_from_scene_volume(target.workspace_xy, target.table_z))
+            plans.append(TargetPlan(i, _choose(target, scene, paid)))
+        except NoFeasibleGrasp as exc:
+            plans.append(TargetPlan(i, None, str(exc)))
+            continue
+        if req.first_found:
+            break
+    return SceneResult(tuple(plans))
+
+
+def _target_points(req: PlanRequest) -> np.ndarray:
+    """(n, 3) the observed points of the request's target, world m; NoFeasibleGrasp without an observation
+    or when the camera saw none."""
+    obs = req.observation
     if obs is None:
         raise NoFeasibleGrasp("vgn plans from the camera's depth views; the request carries no observation")
     target = np.asarray(obs.points)[np.asarray(obs.point_ids) == obs.target_id]
     if len(target) == 0:
         raise NoFeasibleGrasp(f"vgn: the camera saw no point of the target (id {obs.target_id})")
-    if req.workspace_xy is None:
-        scene, cached = scene_grasps(req, world_from_volume(target, req.table_z)), False
-    else:
-        scene, cached = _scene_cached(req)
+    return target
+
+
+def _choose(req: PlanRequest, scene: SceneGrasps, paid: bool) -> PlanResult:
+    """The grasp of ``scene``'s candidates held by the request's target (``planner.selection``); ``paid``:
+    this plan computed ``scene`` (its fusion and inference times go into the extras, else zeros)."""
+    cfg: VgnConfig = req.planner
+    obs = req.observation
     found = scene.found
     chosen = np.flatnonzero(scene.owner == obs.target_id)
     if len(chosen) == 0:
@@ -276,7 +283,7 @@ def plan_vgn(req: PlanRequest) -> PlanResult:
     else:
         pick = int(np.random.default_rng(req.seed).choice(chosen))
     timing = dict(scene.timing)
-    if cached:  # paid by the scene's first request
+    if not paid:
         timing.update(dict.fromkeys(("fuse_wall_s", "fuse_cpu_s", "infer_wall_s", "infer_cpu_s"), 0.0))
     extras = {
         **timing,

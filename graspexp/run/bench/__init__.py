@@ -1,2 +1,2 @@
-"""The measurements behind the ``bench.*`` tools: plan latency, per-phase trial timings, collision shapes
-and the shortlist study (each tool parses its arguments and calls these)."""
+"""The measurements behind the ``bench.*`` tools: plan latency, per-phase trial timings, collision shapes,
+registration accuracy and the shortlist study (each tool parses its arguments and calls these)."""

@@ -11,17 +11,17 @@ from pathlib import Path
 import numpy as np
 
 from graspexp.config.compose import compose_config
+from graspexp.core.run_layout import round_log_path
 from graspexp.core.seeding import round_seed
 from graspexp.datasets import select_objects
-from graspexp.planning import plan
-from graspexp.quality import fc_min_mu
+from graspexp.planning import SceneRequest, SceneResult, plan, plan_scene
 from graspexp.record import TrialRecorder
 from graspexp.record.scene import round_bodies, round_scene
 from graspexp.report.stats import percentiles
 from graspexp.run.job_config import make_ready
-from graspexp.run.objects import load_sim_object, trial_context
+from graspexp.run.objects import load_sim_object, round_context, trial_context
 from graspexp.run.round_loop import draw_objects
-from graspexp.sim.rounds import RoundContext, RoundObject, run_round
+from graspexp.sim.rounds import run_round
 from graspexp.sim.scene import cook_shape
 from graspexp.sim.trial import plain_config, run_trial
 
@@ -54,28 +54,22 @@ def clutter_rounds(overrides: list[str], rounds: int, out: Path) -> tuple[list[d
         drawn = draw_objects(pool, int(cfg.mode.objects_per_round), seed)
         drawn_all += drawn
         loaded = [cache[n] for n in drawn]
-        requests: list = []
+        requests: list[SceneRequest] = []
 
-        def capture(req, requests=requests):
+        def capture(req: SceneRequest, requests=requests) -> SceneResult:
             requests.append(req)
-            return plan(req)
+            return plan_scene(req)
 
         t0, c0 = time.perf_counter(), time.thread_time()
-        path = out / cfg.mode.name / f"{r:03d}.mcap"
+        path = round_log_path(out, cfg.mode.name, r)
         with TrialRecorder(path, {"round": str(r)}, bodies=round_bodies(len(loaded))) as rec:
-            ctx = RoundContext(
-                plain, [RoundObject(o.model, o.hulls) for o in loaded], r, seed, rec,
-                round_scene(plain, [o.hulls for o in loaded]), plan=capture, quality=fc_min_mu,
-            )  # fmt: skip
-            res = run_round(ctx)
+            scene = round_scene(plain, [o.hulls for o in loaded])
+            res = run_round(round_context(plain, loaded, r, seed, rec, scene, planner=capture))
             rec.round_result(res.sim_time_s, res.to_dict())
         wall, cpu = time.perf_counter() - t0, time.thread_time() - c0
-        executed = [a for a in res.attempts if a["executed"]]
+        executed = [a for a in res.attempts if a.executed]
         rows.append({"wall": wall, "cpu": cpu, "attempts": max(1, len(executed)), "placed": res.n_placed})
-        i = 0
-        for a in res.attempts:  # each attempt planned a["n_planned"] objects, in order
-            scenes.append(requests[i : i + a["n_planned"]])
-            i += a["n_planned"]
+        scenes += [list(req.targets) for req in requests]  # each attempt's scene: every object's request
     return rows, scenes, drawn_all
 
 

@@ -12,8 +12,8 @@ logged trials of each object drawn.
 
 from threadpoolctl import threadpool_limits
 
-from graspexp.config.mode import CLUTTER_MODES
 from graspexp.run.bench.round_latency import run_bench
+from graspexp.run.job_config import clutter_modes
 from graspexp.tools.cli import compose_checked, positive_int, take_sweep, tool_parser
 
 
@@ -25,7 +25,7 @@ def main(argv: list[str] | None = None) -> None:
     )
     args = ap.parse_intermixed_args(argv)
     threadpool_limits(limits=1)
-    modes, rest = take_sweep(args.overrides, "mode", CLUTTER_MODES)
+    modes, rest = take_sweep(args.overrides, "mode", clutter_modes())
     trials = [o for o in rest if o.startswith("trials=")]
     rest = [o for o in rest if not o.startswith("trials=")]
     cfg = compose_checked([*rest, f"mode={modes[0]}", *(trials or ["trials=3"])], ap.prog)

@@ -1,13 +1,14 @@
 """Check that two sweeps gave the same trials: ``python -m graspexp bench.compare_runs BEFORE AFTER
 [--planner OLD=NEW]``.
 
-Every ``results.csv`` under BEFORE is matched with the file at the same relative path under AFTER (with
-``--planner OLD=NEW``: a preset renamed between the runs, ``planner=OLD`` in the path and ``OLD`` in the
-``planner`` column stand for ``NEW``), and
-every row (keyed by object and trial) is compared cell by cell as text, so a float that changed in its last
-digit counts. Timing columns (wall-clock ``timings_s*``, CPU ``registration_cpu_s``) are ignored, and so is a column only one side has (a
-result field added between the runs; named in the output). Exit status 0 when every row is
-identical, 1 otherwise (the differing cells are printed).
+Every ``results.csv`` (single-object trials) and every clutter job's ``rounds.csv`` and ``attempts.csv``
+under BEFORE is matched with the file at the same relative path under AFTER (with ``--planner OLD=NEW``: a
+preset renamed between the runs, ``planner=OLD`` in the path and ``OLD`` in the ``planner`` column stand for
+``NEW``), and every row (keyed by object and trial, by round, by round and attempt) is compared cell by cell
+as text, so a float that changed in its last digit counts. Timing columns (:data:`IGNORED_PREFIXES`: wall
+and CPU times) are ignored, and so is a column only one side has (a result field added between the runs;
+named in the output). Exit status 0 when every row is identical, 1 otherwise (the differing cells are
+printed).
 """
 
 import csv
@@ -16,19 +17,24 @@ from pathlib import Path
 
 from graspexp.tools.cli import tool_parser
 
-IGNORED_PREFIXES = ("timings_s", "registration_cpu_s")
+IGNORED_PREFIXES = ("timings_s", "registration_cpu_s", "wall_s", "cpu_s", "plan_s", "plan_cpu_s", "execute_s")
 """Columns that measure time (wall, or CPU): they differ between runs of the same config."""
+TABLES = {"results.csv": ("object", "trial"), "rounds.csv": ("round",), "attempts.csv": ("round", "attempt")}
+"""The tables compared, each with the columns that key its rows."""
 
 
-def _rows(path: Path) -> dict[tuple[str, str], dict[str, str]]:
-    """The rows of one results.csv keyed by (object, trial), timing columns dropped."""
+def _rows(path: Path) -> dict[tuple[str, ...], dict[str, str]]:
+    """The rows of one table keyed by its key columns (:data:`TABLES`), timing columns dropped."""
+    key = TABLES[path.name]
     with path.open(newline="") as f:
         return {
-            (row["object"], row["trial"]): {
-                k: v for k, v in row.items() if not k.startswith(IGNORED_PREFIXES)
-            }
+            tuple(row[k] for k in key): {k: v for k, v in row.items() if not k.startswith(IGNORED_PREFIXES)}
             for row in csv.DictReader(f)
         }
+
+
+def _tables(root: Path) -> list[Path]:
+    return sorted(p for name in TABLES for p in root.rglob(name))
 
 
 def compare(
@@ -38,9 +44,9 @@ def compare(
     ``rename``: (old, new) planner name (module doc). A column only one side has (a result field added
     between the runs) is not compared; its name goes into ``one_sided`` when given."""
     problems = []
-    tables = sorted(p.relative_to(before) for p in before.rglob("results.csv"))
+    tables = sorted(p.relative_to(before) for p in _tables(before))
     if not tables:
-        return [f"no results.csv under {before}"]
+        return [f"no results.csv, rounds.csv or attempts.csv under {before}"]
     for rel in tables:
         rel_after = (
             Path(str(rel).replace(f"planner={rename[0]},", f"planner={rename[1]},")) if rename else rel
@@ -81,14 +87,14 @@ def main(argv: list[str] | None = None) -> int:
         rename = (old, new)
     one_sided: set[str] = set()
     problems = compare(args.before, args.after, rename, one_sided)
-    n_tables = len(list(args.before.rglob("results.csv")))
-    n_rows = sum(len(_rows(p)) for p in args.before.rglob("results.csv"))
+    n_tables = len(_tables(args.before))
+    n_rows = sum(len(_rows(p)) for p in _tables(args.before))
     for line in problems:
         print(line)
     if one_sided:
         print(f"not compared (a column of one side only): {', '.join(sorted(one_sided))}")
     print(
-        f"{n_tables} results.csv, {n_rows} trials: {'identical' if not problems else f'{len(problems)} differences'}"
+        f"{n_tables} tables, {n_rows} rows: {'identical' if not problems else f'{len(problems)} differences'}"
     )
     return 1 if problems else 0
 

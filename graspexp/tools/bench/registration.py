@@ -30,7 +30,7 @@ from threadpoolctl import threadpool_limits  # noqa: E402
 
 from graspexp.datasets import available_objects, job_object  # noqa: E402
 from graspexp.report.paper import PAPER_TABLES  # noqa: E402
-from graspexp.report.registration import registration_report  # noqa: E402
+from graspexp.run.bench.registration import registration_report  # noqa: E402
 from graspexp.tools.cli import compose_checked, positive_int, take_sweep, tool_parser  # noqa: E402
 
 PROG = "graspexp bench.registration"

@@ -1,6 +1,6 @@
-"""Depth views fused into a truncated signed distance grid with Open3D's ``UniformTSDFVolume``, encoded as
-VGN's network input (Breyer et al., CoRL 2020, Sec. III-A: a 40^3 TSDF of a 30 cm cube, truncated at four
-voxels).
+"""The camera's depth views (:class:`graspexp.perception.observation.CameraView`) fused into a truncated
+signed distance grid with Open3D's ``UniformTSDFVolume``, for volumetric planners; encoded as VGN's network
+input (Breyer et al., CoRL 2020, Sec. III-A: a 40^3 TSDF of a 30 cm cube, truncated at four voxels).
 
 Encoding (what VGN's training data holds): a voxel that the views saw within the truncation distance
 holds ``(tsdf + 1) / 2`` in (0.01, 0.99), 0.5 on the surface, above 0.5 in front of it (free space towards
@@ -12,10 +12,11 @@ workspace frame; its value is the distance at its centre.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 import open3d as o3d
+
+from graspexp.perception.observation import CameraView
 
 TRUNCATION_VOXELS = 4.0
 """Truncation distance of the signed distance, in voxel lengths (VGN's: 4 x 7.5 mm = 3 cm)."""
@@ -23,30 +24,17 @@ SEEN_LIMIT = 0.98
 """A voxel whose normalised |tsdf| reaches this counts as not near a surface (Open3D's voxel cloud test)."""
 
 
-@dataclass(frozen=True)
-class DepthView:
-    """One depth image and where it was taken.
-
-    depth : (H, W) float32 metres along the optical axis (0 = no return).
-    K : (3, 3) float64 pinhole intrinsics, px.
-    world_from_camera : (4, 4) float64 camera pose in the world (OpenCV axes: +Z forward, +X right, +Y down).
-    """
-
-    depth: np.ndarray
-    K: np.ndarray
-    world_from_camera: np.ndarray
-
-
 def fuse(
-    views: Sequence[DepthView],
+    views: Sequence[CameraView],
     world_from_volume: np.ndarray,
     size_m: float,
     resolution: int,
     depth_max_m: float,
 ) -> np.ndarray:
     """(resolution,)*3 float32 grid, indexed [i, j, k] along x, y, z of the volume frame, in the encoding
-    above, of the ``size_m`` cube whose corner is ``world_from_volume``'s origin (axes along its x, y, z).
-    Depths beyond ``depth_max_m`` are left out (Open3D's depth truncation)."""
+    above, of the ``size_m`` cube whose corner is ``world_from_volume``'s origin (axes along its x, y, z),
+    fused from the camera's ``views`` (their depth, intrinsics and pose; the ids are not read). Depths
+    beyond ``depth_max_m`` are left out (Open3D's depth truncation)."""
     voxel = size_m / resolution
     volume = o3d.pipelines.integration.UniformTSDFVolume(
         length=size_m,

@@ -1,6 +1,7 @@
-"""What the planner is told at planning time (``perception.*``): the simulator hands the perception stage
-the scene as it is (the object's mesh at its true pose, the support and the floor) and gets back the pose
-the planner sees and, when a camera is rendered, what the camera saw.
+"""The planner's view of a trial or a clutter scene at planning time (``perception.*``): the simulator hands
+this module the scene as it is (each object's mesh at its true pose, the support and the floor) and gets back
+the pose the planner sees and, when a camera is rendered, what the camera saw (:func:`perceive` for one
+object, :func:`perceive_scene` for a clutter scene).
 
 ``perception.source=truth``: the true pose plus ``perception.noise`` (the paper's experiments; no
 camera unless the planner reads it). ``depth``: the camera renders the scene and the pose is registered
@@ -14,12 +15,12 @@ import numpy as np
 
 from graspexp.config import JobConfig
 from graspexp.config.plugins import get_plugin
+from graspexp.core.bodies import FLOOR_HALF_SIZE_M
 from graspexp.core.geometry import pose_error
 from graspexp.core.seeding import rng_for
 from graspexp.datasets.model import ObjectModel
 from graspexp.perception import Observation
 from graspexp.perception.camera import BoxBody, MeshBody
-from graspexp.sim.scene import FLOOR_HALF_SIZE_M
 
 TARGET_ID = 1
 """The object id of the (single) object of a collab or bin trial in the camera's id images."""
