@@ -206,3 +206,46 @@ def test_perception_is_one_stage():
             inside = {d for d in deps if d.startswith("graspexp.perception")} - PERCEPTION_API
             wrong += [f"{module} imports {d}" for d in sorted(inside)]
     assert not wrong, "perception outside graspexp/perception/:\n" + "\n".join(wrong)
+
+
+def _private_imports(path: Path) -> list[str]:
+    """``from graspexp.x import _name`` in ``path`` (another module's private name; a module may import
+    its own package's private helpers only through a public name)."""
+    out = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.module and node.module.split(".")[0] == "graspexp":
+            out += [f"from {node.module} import {a.name}" for a in node.names if a.name.startswith("_")]
+    return out
+
+
+def test_no_module_imports_another_modules_private_names():
+    wrong = [
+        f"{p.relative_to(PACKAGE.parent)}: {line}"
+        for p in PACKAGE.rglob("*.py")
+        for line in _private_imports(p)
+    ]
+    assert not wrong, (
+        "private names imported across modules (make them public or keep them home):\n" + "\n".join(wrong)
+    )
+
+
+def test_the_private_import_check_finds_one(tmp_path):
+    bad = tmp_path / "m.py"
+    bad.write_text("from graspexp.sim.trial import _settle, run_trial\nfrom os import _exit\n")
+    assert _private_imports(bad) == ["from graspexp.sim.trial import _settle"]
+
+
+TOOL_MAX_LINES = 150
+"""A command-line tool is a thin ``main(argv)``: parse, call one library function, print."""
+SHARED_PARSER = "cli.py"
+"""The tools' shared parser and helpers (``graspexp/tools/cli.py``): the one tool module allowed longer."""
+
+
+def test_tool_modules_are_thin():
+    tools = [p for p in (PACKAGE / TOOLS_PACKAGE).rglob("*.py") if p.name != SHARED_PARSER]
+    long = {
+        str(p.relative_to(PACKAGE)): n
+        for p in tools
+        if (n := len(p.read_text().splitlines())) > TOOL_MAX_LINES
+    }
+    assert not long, f"tool modules over {TOOL_MAX_LINES} lines (move the work into a stage): {long}"

@@ -73,7 +73,7 @@ def _enable_disk_cache() -> bool:
 
 
 _CACHE = _enable_disk_cache()
-_jit = numba.njit(cache=_CACHE, nogil=True, error_model="numpy", boundscheck=False)
+jit_kernel = numba.njit(cache=_CACHE, nogil=True, error_model="numpy", boundscheck=False)
 _jit_fast = numba.njit(cache=_CACHE, nogil=True, error_model="numpy", boundscheck=False, fastmath=True)
 
 
@@ -133,7 +133,7 @@ def distance_sums(
     return out
 
 
-@_jit
+@jit_kernel
 def grasp_frames(approaches: np.ndarray, axis: np.ndarray, parallel_tol: float) -> np.ndarray:
     """(B, 3, 3) grasp rotations, columns X, Y, Z (:func:`graspexp.planning.pose.grasp_rotations`).
 
@@ -218,7 +218,7 @@ def kmeans(
     return labels, sums
 
 
-@_jit
+@jit_kernel
 def cluster_max_distances(points: np.ndarray, centers: np.ndarray, labels: np.ndarray) -> np.ndarray:
     """(K,) largest distance of the (n, 3) points from their cluster's centre (``labels`` (n,) int64 index
     the (K, 3) centres); 0 for a cluster without points."""
@@ -358,7 +358,7 @@ SLACK_M = 1e-9
 by :func:`_run_cull` fails the exact test too."""
 
 
-@_jit
+@jit_kernel
 def _soa(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The (N, 3) points as three contiguous (N,) coordinate arrays (structure of arrays: loops vectorise)."""
     return (
@@ -368,7 +368,7 @@ def _soa(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     )
 
 
-@_jit
+@jit_kernel
 def _rotation_run(rotations: np.ndarray, origins: np.ndarray, b: int) -> tuple[int, float, float, float]:
     """End (exclusive) of the run of frames from ``b`` whose (3, 3) rotation is bitwise ``rotations[b]``,
     and how far their origins (B, 3) lie from ``origins[b]`` along that rotation's axes, m: the largest
@@ -392,7 +392,7 @@ def _rotation_run(rotations: np.ndarray, origins: np.ndarray, b: int) -> tuple[i
     return end, dx, dz_lo, dz_hi
 
 
-@_jit
+@jit_kernel
 def _soa32(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     """The (N, 3) points as three float32 coordinate arrays (the cull's pass moves half the bytes and
     runs twice as wide) and the slack, m, that covers the float32 rounding of a frame coordinate computed
@@ -406,7 +406,7 @@ def _soa32(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, floa
     return x32, y32, z32, SLACK_M + 1e-6 * (np.abs(points).max() if points.shape[0] else 0.0)
 
 
-@_jit
+@jit_kernel
 def _run_cull(
     pts32: tuple[np.ndarray, np.ndarray, np.ndarray, float],
     xs: np.ndarray,
@@ -454,7 +454,7 @@ def _run_cull(
     return end, k
 
 
-@_jit
+@jit_kernel
 def _pad_reach(
     r: np.ndarray,
     cull: np.ndarray,
@@ -485,7 +485,7 @@ def _pad_reach(
     return lo, hi
 
 
-@_jit
+@jit_kernel
 def _extremes(y_lo: np.ndarray, y_hi: np.ndarray, k: int, big: float) -> tuple[float, float]:
     """The smallest of ``y_lo[:k]`` and ``big`` and the largest of ``y_hi[:k]`` and ``-big`` (no NaN), in
     four independent chains of selects each (one chain waits on every compare: four run at once). The
@@ -517,7 +517,7 @@ def _extremes(y_lo: np.ndarray, y_hi: np.ndarray, k: int, big: float) -> tuple[f
     return lo, hi
 
 
-@_jit
+@jit_kernel
 def pad_contact_stats(
     points: np.ndarray,
     normals: np.ndarray,
@@ -590,7 +590,7 @@ def pad_contact_stats(
     return out
 
 
-@_jit
+@jit_kernel
 def pad_edge_excess(
     points: np.ndarray,
     poses: np.ndarray,
@@ -634,7 +634,7 @@ BOX_BLOCK = 128
 """Points counted per vectorised block of :func:`_box_hits` before the ``stop_at`` test."""
 
 
-@_jit
+@jit_kernel
 def _box_hits(
     cull: np.ndarray, k: int, r: np.ndarray, h: float, finger: np.ndarray, palm: np.ndarray, stop_at: int
 ) -> int:
@@ -659,7 +659,7 @@ def _box_hits(
     return count
 
 
-@_jit
+@jit_kernel
 def swept_box_hits(
     points: np.ndarray,
     poses: np.ndarray,
@@ -689,7 +689,7 @@ def swept_box_hits(
     return out
 
 
-@_jit
+@jit_kernel
 def box_lowest_z(
     poses: np.ndarray, half_widths: np.ndarray, finger: np.ndarray, palm: np.ndarray
 ) -> np.ndarray:
@@ -713,7 +713,7 @@ def box_lowest_z(
     return out
 
 
-@_jit
+@jit_kernel
 def swept_hull_hits(
     points: np.ndarray,
     poses: np.ndarray,

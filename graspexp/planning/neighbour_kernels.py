@@ -4,10 +4,10 @@ stays valid."""
 
 import numpy as np
 
-from graspexp.planning.kernels import _jit
+from graspexp.planning.kernels import jit_kernel
 
 
-@_jit
+@jit_kernel
 def _box_gap_sq(x: float, y: float, z: float, hx: float, hy: float, z0: float, z1: float) -> float:
     """Squared distance from the point (x, y, z) (frame axes, m) to the box ``|x| <= hx, |y| <= hy,
     z0 <= z <= z1``, m^2 (0 inside)."""
@@ -17,7 +17,7 @@ def _box_gap_sq(x: float, y: float, z: float, hx: float, hy: float, z0: float, z
     return dx * dx + dy * dy + dz * dz
 
 
-@_jit
+@jit_kernel
 def cells_swept_hits(
     points: np.ndarray,
     starts: np.ndarray,
@@ -79,7 +79,7 @@ def cells_swept_hits(
     return out
 
 
-@_jit
+@jit_kernel
 def cube_sort(points: np.ndarray, side: float, slack: float):
     """The (N, 3) cloud ``points`` (m) sorted into cubes of side ``side`` (m) from its lowest corner, by a
     counting sort: (sorted points (N, 3), starts (C + 1,) int64, centres (C, 3), radii (C,)) of the C
@@ -145,7 +145,7 @@ def cube_sort(points: np.ndarray, side: float, slack: float):
     return out, starts, centres, radii
 
 
-@_jit
+@jit_kernel
 def occupancy_grid(points: np.ndarray, side: float, max_cells: int):
     """Which cubes of side ``side`` (m; cube ``floor(p / side)`` per axis, as :func:`graspexp.planning.
     cells.cube_keys`) hold a point of ``points`` (N, 3): a (X, Y, Z) uint8 grid over the occupied cubes' box
@@ -171,7 +171,7 @@ def occupancy_grid(points: np.ndarray, side: float, max_cells: int):
     return grid, first
 
 
-@_jit
+@jit_kernel
 def paths_clear(
     centers: np.ndarray,
     steps: np.ndarray,

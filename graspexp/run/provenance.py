@@ -71,11 +71,13 @@ def cpu_flags() -> frozenset[str] | None:
 
 @functools.cache
 def cpu_class() -> str:
-    """The CPU class a results fingerprint holds on (``x86_64-v4``, ``x86_64-v3``, ``x86_64-v2``, or the
-    architecture's name elsewhere): numpy's vector loops, OpenBLAS's kernels and numba's code are chosen by
-    the instruction set at run time, and the last bits they leave can turn a simulated trial. Measured: the
-    readings' default sweep (Tables 1 and 2, 10 drops per object and setting) turns 0 to 3 of the 90 YCB
-    trials per setting on an AVX-512 machine against AVX2 ones, and no LINEMOD trial."""
+    """The CPU class a results fingerprint holds on (``x86_64-v4-intel``, ``x86_64-v3-amd``, ..., or the
+    architecture's name elsewhere): the x86-64 level and the vendor. numpy's vector loops, OpenBLAS's kernels
+    and numba's code are chosen by the instruction set and the core type at run time, and the last bits they
+    leave can turn a simulated trial. Measured: the readings' default sweep (Tables 1 and 2, 10 drops per
+    object and setting) turns 0 to 3 of the 90 YCB trials per setting on an AVX-512 machine against AVX2
+    ones, and no LINEMOD trial; an Intel Xeon with AVX-512 gives other fingerprints than an AMD EPYC with
+    AVX-512 for every page (OpenBLAS's SkylakeX kernels against Zen's, among others)."""
     arch = platform.machine()
     if arch != "x86_64":
         return arch or "unknown"
@@ -83,7 +85,22 @@ def cpu_class() -> str:
     if flags is None:
         return "x86_64"
     level = 4 if X86_V4 <= flags and X86_V3 <= flags else 3 if X86_V3 <= flags else 2
-    return f"x86_64-v{level}"
+    vendor = VENDORS.get(cpu_vendor(), cpu_vendor().lower())
+    return f"x86_64-v{level}" + (f"-{vendor}" if vendor else "")
+
+
+VENDORS = {"GenuineIntel": "intel", "AuthenticAMD": "amd"}
+"""Short names of the ``vendor_id`` of /proc/cpuinfo in a CPU class."""
+
+
+@functools.cache
+def cpu_vendor() -> str:
+    """The CPU's ``vendor_id`` (/proc/cpuinfo; ``""`` where it has none or cannot be read)."""
+    try:
+        lines = Path("/proc/cpuinfo").read_text().splitlines()
+    except OSError:
+        return ""
+    return next((ln.split(":", 1)[1].strip() for ln in lines if ln.startswith("vendor_id")), "")
 
 
 def job_metadata(cfg: DictConfig) -> dict[str, str]:

@@ -27,7 +27,7 @@ from graspexp.core.seeding import derive_seed, rng_for
 from graspexp.perception.scene_view import ScenePerceived, perceive_scene, slot_id
 from graspexp.planning.grasp import Grasp
 from graspexp.planning.request import Neighbour, PlanRequest
-from graspexp.planning.scene import ScenePlanner, SceneRequest, timed
+from graspexp.planning.scene import ScenePlanner, SceneRequest, TargetPlan, timed
 from graspexp.sim.round_scene import RoundObject, clutter_scene
 from graspexp.sim.round_sim import RoundSim, settle_all
 from graspexp.sim.scene_types import SceneType, scene_type
@@ -178,6 +178,16 @@ def _attempts(ctx: RoundContext, sim: RoundSim, res: RoundResult) -> RoundEnd:
     return RoundEnd.CLEARED
 
 
+@dataclass(frozen=True)
+class _Seen:
+    """One object of the scene as the planner sees it: its slot, perceived (4, 4) world pose and (N, 3) world
+    cloud (its model's points at that pose), m."""
+
+    slot: int
+    pose: np.ndarray
+    points: np.ndarray
+
+
 def _plan_scene(
     ctx: RoundContext, sim: RoundSim, attempt: int, seed: int
 ) -> tuple[AttemptResult, Grasp | None]:
@@ -188,88 +198,91 @@ def _plan_scene(
     view = perceive_scene(
         cfg, {s: (ctx.objects[s].model, ts.pose_of(name)) for name, s in slots.items()}, ts.table_z, seed
     )
-    seen = {}
-    for name, slot in slots.items():
-        pose = view.poses[slot]
-        seen[name] = (slot, pose, transform_points(pose, ctx.objects[slot].model.points))
+    seen = {
+        name: _Seen(
+            slot, view.poses[slot], transform_points(view.poses[slot], ctx.objects[slot].model.points)
+        )
+        for name, slot in slots.items()
+    }
     order = sorted(seen)
     if cfg.mode.pick_order == "top_most":
-        order.sort(key=lambda b: -float(seen[b][2][:, 2].max()))
+        order.sort(key=lambda b: -float(seen[b].points[:, 2].max()))
     half = np.asarray(cfg.mode.workspace_half_size_m, dtype=np.float64)
     workspace_xy = np.stack([-half, half])  # about the support's centre, world x = y = 0
-    requests = tuple(_request(ctx, ts.table_z, seen, name, seed, view, workspace_xy) for name in order)
     scene_req = SceneRequest(
-        requests,
-        tuple(slot_id(seen[name][0]) for name in order),
+        tuple(_request(ctx, ts.table_z, seen, name, seed, view, workspace_xy) for name in order),
+        tuple(slot_id(seen[name].slot) for name in order),
         first_found=cfg.mode.pick_order == "top_most",
         observation=view.observation,
     )
     with sim.timed("plan"):
         found, wall, cpu = timed(ctx.plan_scene, scene_req)
     n = len(found.plans)
-    plans: list[tuple[bool, float, int, str, Grasp]] = []
-    for tp in found.plans:
-        grasp = tp.grasp
-        if grasp is not None:
-            cost = grasp.cost if np.isfinite(grasp.cost) else np.inf
-            plans.append((grasp.touches_neighbours, cost, tp.index, order[tp.index], grasp))
-    first = seen[order[0]][0]
+    first = seen[order[0]].slot
     row = AttemptResult(
         round=ctx.round, attempt=attempt, target=ctx.objects[first].model.name, slot=first, executed=False,
         success=False, reason=FailureReason.NO_FEASIBLE_GRASP.value, pick_order=cfg.mode.pick_order,
         n_left=len(seen), n_planned=n, plan_s=wall, plan_cpu_s=cpu, sim_time_s=sim.t,
     )  # fmt: skip
     _pose_errors(row, view.errors.get(first))
-    if not plans:
+    chosen = min((tp for tp in found.plans if tp.grasp is not None), key=_preference, default=None)
+    if chosen is None:
         _log_camera(ctx, sim, view, order[0], first)
         sim.phase(Phase.PLAN, {"attempt": attempt, "found": False, "n_planned": n})
         return row, None
-    *_, name, grasp = min(
-        plans, key=lambda p: p[:3]
-    )  # a grasp clear of the neighbours first, then cost, order
-    slot = seen[name][0]
+    name, grasp = order[chosen.index], chosen.grasp
+    slot = seen[name].slot
     _log_camera(ctx, sim, view, name, slot)
     row.target, row.slot, row.executed, row.reason = ctx.objects[slot].model.name, slot, True, None
     row.grasp_cost, row.grasp_width_m, row.n_feasible = grasp.cost, grasp.width_m, grasp.n_feasible
     _pose_errors(row, view.errors.get(slot))
     sim.phase(Phase.PLAN, {"attempt": attempt, "target": name, "object": row.target, "n_planned": n,
-                       "pick_order": cfg.mode.pick_order, "plan_s": wall})  # fmt: skip
+                           "pick_order": cfg.mode.pick_order, "plan_s": wall})  # fmt: skip
     ctx.recorder.grasp(sim.log_t, {**grasp_record(grasp), "target": name})
     return row, grasp
+
+
+def _preference(tp: TargetPlan) -> tuple[bool, float, int]:
+    """The order in which the scene's grasps are preferred: one clear of the neighbours first, then the least
+    cost (NaN: last), then the target planned first."""
+    cost = tp.grasp.cost if np.isfinite(tp.grasp.cost) else np.inf
+    return tp.grasp.touches_neighbours, cost, tp.index
 
 
 def _request(
     ctx: RoundContext,
     table_z: float,
-    seen: dict[str, tuple[int, np.ndarray, np.ndarray]],
+    seen: dict[str, _Seen],
     name: str,
     seed: int,
     view: ScenePerceived,
     workspace_xy: np.ndarray,
 ) -> PlanRequest:
-    """The plan request for body ``name`` of the scene ``seen`` (body -> (slot, perceived (4, 4) pose, (N, 3)
-    world cloud)): the others are its neighbours, the camera's observation names it the target."""
+    """The plan request for body ``name`` of the scene ``seen`` (body -> what the planner sees of it): the
+    others are its neighbours, the camera's observation names it the target."""
     cfg = ctx.cfg
-    slot, pose, points = seen[name]
-    model = ctx.objects[slot].model
+    target = seen[name]
+    model = ctx.objects[target.slot].model
     return PlanRequest(
-        points=points,
-        normals=model.normals @ pose[:3, :3].T,
+        points=target.points,
+        normals=model.normals @ target.pose[:3, :3].T,
         area_mask=model.area_mask,
-        object_pose=pose,
+        object_pose=target.pose,
         table_z=table_z,
         mode=PLANNING_MODE,
         gripper=cfg.gripper,
         planner=cfg.planner,
         cost=cfg.cost,
-        seed=derive_seed(seed, "plan", slot),
+        seed=derive_seed(seed, "plan", target.slot),
         support_blocks_gripper=bool(cfg.mode.support_collides_with_gripper),
         neighbours=tuple(
-            Neighbour(s, ctx.objects[s].model.name, p, q) for b, (s, q, p) in seen.items() if b != name
+            Neighbour(o.slot, ctx.objects[o.slot].model.name, o.points, o.pose)
+            for b, o in seen.items()
+            if b != name
         ),
         observation=None
         if view.observation is None
-        else dataclasses.replace(view.observation, target_id=slot_id(slot)),
+        else dataclasses.replace(view.observation, target_id=slot_id(target.slot)),
         workspace_xy=workspace_xy,
     )
 

@@ -3,6 +3,7 @@ schema's default (the schema's default is the effective default of the preset th
 planner of a shared schema uses every default, its variants state their differences)."""
 
 import dataclasses
+import typing
 from pathlib import Path
 
 import pytest
@@ -62,18 +63,27 @@ def _same(value: object, default: object) -> bool:
     return value == default
 
 
-def repeated_defaults(path: Path) -> list[str]:
-    """``key: value`` of every value of the YAML option ``path`` that equals its schema's default."""
-    data = yaml.safe_load(path.read_text())
+def _repeated(values: dict, schema: type, prefix: str) -> list[str]:
+    """``key: value`` of every value of ``values`` (a node typed by ``schema``) that equals its schema's
+    default, nested nodes (a dataclass field set as a mapping) checked against their own schema."""
+    fields = {f.name: f for f in dataclasses.fields(schema)}
+    hints = typing.get_type_hints(schema)
     out = []
-    for prefix, values, schema in _nodes(data):
-        fields = {f.name: f for f in dataclasses.fields(schema)}
-        out += [
-            f"{prefix}{key}: {value!r}"
-            for key, value in values.items()
-            if key in fields and _same(value, _default(fields[key]))
-        ]
+    for key, value in values.items():
+        if key not in fields:
+            continue
+        if dataclasses.is_dataclass(hints.get(key)) and isinstance(value, dict):
+            out += _repeated(value, hints[key], f"{prefix}{key}.")
+        elif _same(value, _default(fields[key])):
+            out.append(f"{prefix}{key}: {value!r}")
     return out
+
+
+def repeated_defaults(path: Path) -> list[str]:
+    """``key: value`` of every value of the YAML option ``path`` that equals its schema's default, at any
+    depth."""
+    data = yaml.safe_load(path.read_text())
+    return [line for prefix, values, schema in _nodes(data) for line in _repeated(values, schema, prefix)]
 
 
 @pytest.mark.parametrize("path", _presets(), ids=lambda p: str(p.relative_to(CONF)))
@@ -98,3 +108,8 @@ def test_the_check_finds_a_repeated_default(tmp_path):
         "camera:\n  name: kinect\n  width_px: 424\ndepth_noise:\n  axial_a_m: 0.002\n  edge_jump_m: 0.02\n"
     )
     assert repeated_defaults(camera) == ["camera.width_px: 424", "depth_noise.edge_jump_m: 0.02"]
+    job = tmp_path / "config.yaml"
+    job.write_text(
+        "defaults:\n  - /schema_job@_here_\nseed: 7\nperception:\n  noise:\n    trans_mm: 0.0\n    rot_deg: 2.0\n"
+    )
+    assert repeated_defaults(job) == ["perception.noise.trans_mm: 0.0"]  # a nested key, found at its depth
