@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from graspexp.core.rounds import RoundEnd, RoundResult
+from graspexp.core.rounds import AttemptResult, RoundEnd, RoundResult
 from graspexp.core.run_layout import ATTEMPTS_CSV, ROUNDS_CSV, TRIALS_DIR
 from graspexp.record import CorruptLogError, iter_trial_logs, read_round
 from graspexp.report.collect import is_round_log
@@ -96,7 +96,8 @@ def _rounds_from_csv(run_dir: Path) -> list[RoundResult]:
             RoundResult(
                 dataset=row["dataset"], mode=row["mode"], planner=row["planner"], round=int(row["round"]),
                 seed=int(row["seed"]), drawn=str(row["drawn"]).split(), placed=str(row["placed"]).split(),
-                removed=str(row["removed"]).split(), end=row["end"], attempts=mine, error=str(row["error"]),
+                removed=str(row["removed"]).split(), end=row["end"], attempts=[AttemptResult(**a) for a in mine],
+                error=str(row["error"]),
             )
         )  # fmt: skip
     return out

@@ -54,7 +54,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
     ckpt = known[args.name]
-    folder = (args.dir or checkpoint_dir()).expanduser()
+    found = [d / ckpt.filename for d in checkpoint_dirs() if (d / ckpt.filename).is_file()]
+    folder = (args.dir or (found[0].parent if found else checkpoint_dir())).expanduser()
     try:
         path = fetch(args.url or ckpt.url, folder, ckpt.filename, ckpt.sha256, progress=not args.quiet)
     except DatasetError as err:

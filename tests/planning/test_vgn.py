@@ -94,8 +94,13 @@ def test_the_checkpoint_loads_strictly_and_its_outputs_are_deterministic():
     first = vgn.infer(net, grid, threads=1)
     again = vgn.infer(vgn_network.load_vgn(), grid, threads=1)
     two_threads = vgn.infer(net, grid, threads=2)
-    for a, b, c in zip(first, again, two_threads, strict=True):
-        assert np.array_equal(a, b) and np.array_equal(a, c)
+    two_again = vgn.infer(net, grid, threads=2)
+    # the same thread count gives the same outputs bit for bit; another count may move the last digits (torch
+    # splits the convolutions' sums by thread: measured on an Intel Xeon with AVX-512), so ``planner.threads``
+    # is part of what decides a result
+    for a, b, c, d in zip(first, again, two_threads, two_again, strict=True):
+        assert np.array_equal(a, b) and np.array_equal(c, d)
+        np.testing.assert_allclose(a, c, rtol=1e-4, atol=1e-5)
     quality, rot, width = first
     assert quality.shape == width.shape == (40, 40, 40) and rot.shape == (4, 40, 40, 40)
     assert 0 <= quality.min() and quality.max() <= 1

@@ -375,7 +375,7 @@ def test_compare_runs_matches_a_renamed_preset_cell_by_cell(tmp_path: Path, caps
     before, after = str(tmp_path / "before"), str(tmp_path / "after")
     assert compare_main([before, after]) == 1  # other job directory names
     assert compare_main([before, after, "--planner", "optimal=optimal_in_area"]) == 0
-    assert "1 trials: identical" in capsys.readouterr().out
+    assert "1 rows: identical" in capsys.readouterr().out
     (tmp_path / "after" / "dataset=ycb,mode=bin,planner=optimal_in_area,rot=z" / "results.csv").write_text(
         rows.format(p="optimal_in_area", t=0.2).replace("True", "False")
     )

@@ -128,7 +128,7 @@ def test_the_clutter_modes_run_one_job_per_scene_and_rank_planners_by_dr_then_gs
             return [
                 AttemptResult(round=r, attempt=i, target="a", slot=i, executed=True, success=i < n,
                               reason=None if i < n else "dropped", pick_order="lowest_cost", n_left=2 - i,
-                              n_planned=2 - i, plan_s=0.01, plan_cpu_s=0.01).to_dict()
+                              n_planned=2 - i, plan_s=0.01, plan_cpu_s=0.01)
                 for i in range(n + 1)
             ]  # fmt: skip
 

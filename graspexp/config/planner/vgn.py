@@ -53,8 +53,9 @@ class VgnConfig(PlannerConfig):
     width_clearance_m: float = 0.005
     """With ``opening=predicted``: clearance added on each side of the predicted width, m."""
     threads: int = 1
-    """torch threads of the forward pass (1: one core, as the runner gives each job; the outputs are the
-    same for any count, the test checks it)."""
+    """torch threads of the forward pass (1: one core, as the runner gives each job). The outputs repeat bit
+    for bit for one count; another count may move their last digits (torch splits the convolutions' sums by
+    thread; measured on an Intel Xeon with AVX-512), so the count is part of what decides a result."""
 
 
 CONSTRAINTS = {

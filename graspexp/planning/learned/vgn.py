@@ -38,7 +38,7 @@ from graspexp.perception.tsdf import fuse
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.learned.vgn_network import GRID, VgnNet, load_vgn
 from graspexp.planning.request import PlanRequest, PlanResult
-from graspexp.planning.scene import SceneRequest, SceneResult, TargetPlan
+from graspexp.planning.scene import SceneRequest, SceneResult, per_object
 
 SIZE_M = 0.3
 """Edge of VGN's workspace cube, m (6 finger depths; the network was trained on it)."""
@@ -238,20 +238,16 @@ def plan_vgn_scene(req: SceneRequest) -> SceneResult:
     candidates are those assigned to it. Targets in the request's order (``first_found``: up to the first
     grasp found); the fusion's and inference's times are in the extras of the target that paid them."""
     scene: SceneGrasps | None = None
-    plans = []
-    for i, target in enumerate(req.targets):
-        try:
-            _target_points(target)
-            paid = scene is None
-            if scene is None:
-                scene = scene_grasps(target, world_from_scene_volume(target.workspace_xy, target.table_z))
-            plans.append(TargetPlan(i, _choose(target, scene, paid)))
-        except NoFeasibleGrasp as exc:
-            plans.append(TargetPlan(i, None, str(exc)))
-            continue
-        if req.first_found:
-            break
-    return SceneResult(tuple(plans))
+
+    def plan_target(target: PlanRequest) -> PlanResult:
+        nonlocal scene
+        _target_points(target)
+        paid = scene is None
+        if scene is None:
+            scene = scene_grasps(target, world_from_scene_volume(target.workspace_xy, target.table_z))
+        return _choose(target, scene, paid)
+
+    return per_object(plan_target)(req)
 
 
 def _target_points(req: PlanRequest) -> np.ndarray:

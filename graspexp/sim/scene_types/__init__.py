@@ -1,13 +1,16 @@
 """Scene types of a clutter round, registered by name (``mode.scene``): how the drawn objects come onto
-the table. Each is a class implementing :class:`SceneType`, in a module of this package, registered with
-:func:`register`; a preset ``conf/mode/<name>.yaml`` (schema ``/schema_clutter_mode``) selects it. ``pile``
-and ``packed`` are VGN's and GIGA's two scenes (Breyer et al., CoRL 2020; Jiang et al., RSS 2021).
+the table. Each is a class implementing :class:`SceneType`, registered with :func:`register`, in a module
+of this package or of another package that names the module under the entry-point group
+:data:`ENTRY_POINT_GROUP` (as planners register theirs); a preset ``conf/mode/<name>.yaml`` (schema
+``/schema_clutter_mode``) selects it. ``pile`` and ``packed`` are VGN's and GIGA's two scenes (Breyer et
+al., CoRL 2020; Jiang et al., RSS 2021).
 """
 
 import functools
 import importlib
 import pkgutil
 from collections.abc import Callable, Sequence
+from importlib.metadata import entry_points
 from typing import Protocol
 
 import numpy as np
@@ -31,6 +34,8 @@ class SceneType(Protocol):
         ``rng``."""
 
 
+ENTRY_POINT_GROUP = "graspexp.scene_types"
+"""Entry-point group of other packages' scene-type modules (``name = "package.module"``)."""
 _REGISTERED: dict[str, type] = {}
 
 
@@ -48,9 +53,17 @@ def register(name: str) -> Callable[[type], type]:
 
 @functools.cache
 def _discover() -> None:
-    """Import every module of this package once: each registers its scene types."""
+    """Import every module of this package and every module named under :data:`ENTRY_POINT_GROUP` once: each
+    registers its scene types."""
     for info in pkgutil.iter_modules(__path__):
         importlib.import_module(f"{__name__}.{info.name}")
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        try:
+            importlib.import_module(ep.value.partition(":")[0])
+        except ImportError as exc:
+            raise ConfigError(
+                f"scene type module {ep.value} (entry point {ep.name!r}) cannot be imported: {exc}"
+            ) from None
 
 
 def scene_type_names() -> list[str]:
