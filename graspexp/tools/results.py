@@ -1,8 +1,9 @@
 """``python -m graspexp results [--check | --stamp-cpu] [--pages a,b | --learned-planners] [--out OUT] [--root DIR] [--n-jobs N] [key=value ...]``:
 regenerate every results page (``docs/results/*.md`` and the README's results table) from runs of the
 current code, or with ``--check`` list the pages whose fingerprint the current code does not reproduce.
-A fingerprint holds bit for bit on one CPU class (``x86_64-v3``: AVX2; ``x86_64-v4``: AVX-512): ``--check``
-compares this machine's class's and skips, with a line, a page stamped on other classes only;
+A fingerprint holds bit for bit on one CPU class (``x86_64-v3-amd``: AVX2, AMD; ``x86_64-v4-intel``:
+AVX-512, Intel): ``--check`` compares this machine's class's and skips, with a line, a page stamped on other
+classes only;
 ``--stamp-cpu`` adds this class's fingerprints to the pages made on another (run it where they are current).
 
 Each page's sweeps run as Hydra multiruns (joblib launcher) into ``OUT/runs/`` (default
