@@ -4,6 +4,7 @@ every object (the Hydra app; the command line is parsed and checked first by
 :data:`graspexp.tools.TOOLS`."""
 
 import importlib
+import logging
 import sys
 from collections.abc import Sequence
 
@@ -23,6 +24,9 @@ register_configs()
     version_base="1.3", config_path=CONF_DIR, config_name="config"
 )  # absolute: also for the console script
 def _job(cfg: DictConfig) -> float | None:
+    # a log handler that cannot write (Hydra's job log on a full disk, a removed or read-only run directory)
+    # drops the message instead of printing logging's own traceback: the job's one error line says what failed
+    logging.raiseExceptions = False
     from graspexp.datasets import DatasetError
     from graspexp.record.live import LiveViewError
     from graspexp.run.locks import RunError

@@ -36,6 +36,7 @@ from graspexp.run.locks import RunError
 from graspexp.run.objects import LoadedObject, round_context
 from graspexp.run.provenance import job_metadata
 from graspexp.run.resume import finished_log
+from graspexp.run.trial_loop import write_failure
 from graspexp.sim.rounds import run_round
 from graspexp.sim.trial import plain_config
 
@@ -97,7 +98,7 @@ def _run_one(cfg, plain, job_meta, path: Path, r: int, seed: int, loaded: list[L
     except Exception as exc:
         if not is_write_error(exc):
             raise
-        raise RunError(f"cannot write the round log {path}: {exc}") from None
+        raise RunError(write_failure(path, exc, "round")) from None
     return result
 
 

@@ -51,7 +51,7 @@ def run_object_trials(
     except LinkedRunPathError as exc:
         raise RunError(str(exc)) from None
     except OSError as exc:
-        raise RunError(_write_failure(first, exc)) from None
+        raise RunError(write_failure(first, exc)) from None
     if isinstance(loaded, str):
         return _unusable_object_trials(cfg, object_name, run_dir, loaded, bar)
     results = []
@@ -74,7 +74,7 @@ def run_object_trials(
             except Exception as exc:
                 if not is_write_error(exc):
                     raise
-                raise RunError(_write_failure(path, exc)) from None
+                raise RunError(write_failure(path, exc)) from None
         results.append(result)
         if bar is not None:
             bar.set_postfix_str(f"{object_name} #{i}: {'ok' if result.success else result.reason}")
@@ -82,17 +82,18 @@ def run_object_trials(
     return results
 
 
-def _write_failure(path: Path, exc: BaseException) -> str:
-    """The message of a trial log that cannot be written (with what to do when the disk is full)."""
+def write_failure(path: Path, exc: BaseException, kind: str = "trial") -> str:
+    """The message of a ``kind`` (trial, round) log that cannot be written (with what to do when the disk is
+    full)."""
     why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
     full = not isinstance(exc, OSError) or exc.errno in NO_SPACE_ERRNOS
     hint = (
         "; the disk may be full: free space, then run the same command again (finished "
-        "trials are kept and reused)"
+        f"{kind}s are kept and reused)"
         if full
         else ""
     )
-    return f"cannot write the trial log {path}: {why}{hint}"
+    return f"cannot write the {kind} log {path}: {why}{hint}"
 
 
 def _unusable_object_trials(

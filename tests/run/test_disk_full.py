@@ -41,3 +41,37 @@ def test_a_full_disk_is_one_line_and_the_run_resumes(tmp_path, finished_run):
     keys = ["object", "trial", "seed", "success", "reason", "slip_m", "steps"]
     resumed, reference = (pd.read_csv(d / "results.csv")[keys] for d in (run_dir, finished_run))
     pd.testing.assert_frame_equal(resumed, reference)
+
+
+def _tmpfs(path: Path, size: str) -> bool:
+    """Mount a ``size`` tmpfs at ``path``; False where this process may not mount (not root, no CAP_SYS_ADMIN)."""
+    path.mkdir(parents=True, exist_ok=True)
+    return (
+        subprocess.run(
+            ["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(path)], capture_output=True
+        ).returncode
+        == 0
+    )
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="a tmpfs mount")
+@pytest.mark.parametrize(
+    "job",
+    [["dataset=primitives", "trials=20"], ["mode=pile", "dataset=primitives", "trials=6"]],
+    ids=["trials", "rounds"],
+)
+def test_a_run_on_a_full_tmpfs_prints_no_traceback(tmp_path, job):
+    """A real full disk (a 1 MiB tmpfs) fills while the logs are written: one error line, exit status 2, and
+    no traceback anywhere in the output (Hydra's job log file, which cannot be written either, included)."""
+    disk = tmp_path / "disk"
+    if not _tmpfs(disk, "1m"):
+        pytest.skip("cannot mount a tmpfs here (needs root)")
+    try:
+        full = graspexp(*job, "progress=false", f"hydra.run.dir={disk / 'run'}")
+    finally:
+        subprocess.run(["umount", str(disk)], capture_output=True)
+    assert full.returncode == 2, (full.stdout[-1000:], full.stderr[-2000:])
+    out = full.stdout + full.stderr
+    assert "Traceback" not in out and "Logging error" not in out, full.stderr[-3000:]
+    errors = [ln for ln in full.stderr.splitlines() if ln.startswith("graspexp: error:")]
+    assert len(errors) == 1 and "free space" in errors[0], full.stderr[-2000:]
