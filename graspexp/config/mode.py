@@ -67,6 +67,29 @@ class ClutterModeConfig(ModeConfig):
     placement_gap_m: float = 0.01
     """``packed``: least gap between the footprints (each model's x-y bounding rectangle, turned by its yaw)
     of two objects placed upright, m: side by side, not touching."""
+    object_scale: list[float] = field(default_factory=lambda: [1.0, 1.0])
+    """[min, max]: each object placed in a round is scaled (its mesh, cloud and collision shape, about its
+    own origin) by a factor drawn uniformly from this range, per object and round, from the round's seed.
+    The protocol of VGN and GIGA scales its test objects per scene by U(0.8, 1.0) in pile scenes and
+    U(0.7, 0.9) in packed scenes (ethz-asl/vgn ``src/vgn/simulation.py``; ``protocol=giga``, ``protocol=vgn``
+    set it): the sets were normalised to the Panda's stroke and the scale varies them. The mass stays the
+    object's, as PyBullet's ``globalScaling`` keeps a URDF's mass in their simulation. [1, 1]: every object
+    at its own size and nothing drawn (the rounds of every preset, as before the key); min = max: one fixed
+    factor."""
+    packed_placement: str = "gap"
+    """``packed``: how the objects are stood upright. ``gap``: each drawn object in turn at a random place
+    of the workspace whose footprint keeps ``placement_gap_m`` from the others', up to 200 tries each
+    (:func:`graspexp.sim.scene_types.packed.packed_poses`). ``vgn``: VGN's and GIGA's ``generate_packed``
+    (ethz-asl/vgn ``src/vgn/simulation.py``): ``packed_attempts`` attempts in all, each stands the next
+    object not yet placed upright at a random yaw with its origin uniform within ``packed_centre_half_m`` of
+    the workspace centre, ``rot.drop_height_m`` above the table; an object that touches another after one
+    physics step is taken away again (the others put back as they were) and waits for a later attempt, one
+    that does not is left to settle."""
+    packed_attempts: int = 12
+    """``packed_placement=vgn``: placement attempts per round (VGN's ``max_attempts = 12``)."""
+    packed_centre_half_m: float = 0.07
+    """``packed_placement=vgn``: each attempt's origin is drawn uniformly within this of the workspace centre
+    in x and y, m (VGN: [0.08, 0.22] m of its 0.3 m workspace)."""
     pick_order: str = "lowest_cost"
     """Which object to grasp next. ``lowest_cost``: plan every object on the table (the
     planner sees the others as obstacles) and execute the grasp of least cost (the paper's Eq. 2-3 choice
@@ -89,6 +112,8 @@ class ClutterModeConfig(ModeConfig):
 
 PICK_ORDERS = ("lowest_cost", "top_most")
 """The values of ``mode.pick_order``."""
+PACKED_PLACEMENTS = ("gap", "vgn")
+"""The values of ``mode.packed_placement``."""
 NAME = [Pattern(r"[A-Za-z0-9][A-Za-z0-9_.-]*", "a name of letters, digits, '_', '.' and '-'")]
 """A clutter mode's name: its rounds' log folder ``trials/<name>/``."""
 
@@ -115,6 +140,10 @@ CLUTTER_CONSTRAINTS = {
     "tray_wall_height_m": [Interval(0, 2, "right", "m")],
     "drop_height_m": [Interval(0, 2, unit="m")],
     "placement_gap_m": [Interval(0, 1, unit="m")],
+    "object_scale": [Vector(2, Interval(0, 10, "neither"))],
+    "packed_placement": [Options(PACKED_PLACEMENTS)],
+    "packed_attempts": [Interval(1, 10_000, integer=True)],
+    "packed_centre_half_m": [Interval(0, 5, unit="m")],
     "pick_order": [Options(PICK_ORDERS)],
     "sleep_threshold": [Interval(0, 1, unit="m^2/s^2")],
 }

@@ -18,7 +18,7 @@ SOURCES = ("truth", "depth")
 """Values of ``perception.source``."""
 PRIORS = ("noisy_truth", "none")
 """Values of ``perception.registration.prior``."""
-DEPTH_NOISE_MODELS = ("nguyen",)
+DEPTH_NOISE_MODELS = ("nguyen", "dex")
 """Values of ``perception.depth_noise.model``: the noise models the perception stage implements, each a
 function registered under its name (:data:`graspexp.perception.depth_noise.NOISE_MODELS`)."""
 CAMERA_EXTRA = "pip install 'graspexp[camera]'"
@@ -99,13 +99,20 @@ class DepthNoiseConfig:
     ``sigma_L(theta) = l0 + l1 * theta / (pi/2 - theta)`` px (z depth in m, theta the angle between the ray
     and the surface normal, rad). Their coefficients are the defaults; a structured-light Kinect's noise
     grows with z^2 as a stereo D435's does (its RMS error is about 2 % of the depth at 2 m in Intel's
-    datasheet). Missing pixels: beyond ``max_incidence_deg`` and at depth edges."""
+    datasheet). Missing pixels: beyond ``max_incidence_deg`` and at depth edges.
+
+    ``dex``: the depth noise of GIGA's simulated benchmark (Jiang et al., "Synergies Between Affordance and
+    Geometry: 6-DoF Grasp Detection via Implicit Representations", RSS 2021; ``apply_dex_noise`` in
+    supersglzc/GIGA ``src/vgn/utils/misc.py``, after Dex-Net's depth noise): the frame's depth times one
+    Gamma(k, theta) factor, then, with probability ``dex_gp_probability``, plus a Gaussian field of std
+    ``dex_gp_sigma_m`` drawn on a grid ``dex_gp_downsample`` times coarser than the image and bilinearly
+    upsampled (zero beyond the grid's edge). No pixel goes missing."""
 
     enabled: bool = True
     """False: exact depth (no noise, no missing pixels but out-of-range ones)."""
     model: str = "nguyen"
     """The noise model (:mod:`graspexp.perception.depth_noise`): ``nguyen``, Nguyen et al. 2012's axial and
-    lateral noise with the coefficients below."""
+    lateral noise with the coefficients below; ``dex``, GIGA's (the ``dex_*`` coefficients)."""
     axial_a_m: float = 0.0012
     """a, m (Nguyen et al. 2012)."""
     axial_b_m: float = 0.0019
@@ -124,6 +131,20 @@ class DepthNoiseConfig:
     edge_jump_m: float = 0.02
     """A pixel whose 4-neighbour depth differs by more than this returns nothing (stereo matching fails
     at depth discontinuities), m."""
+    dex_gamma_shape: float = 1000.0
+    """``dex``: shape k of the Gamma distribution of the frame's multiplicative depth factor (GIGA's
+    ``gamma_shape``: mean k theta = 1, std sqrt(k) theta = 3.2 %)."""
+    dex_gamma_scale: float = 0.001
+    """``dex``: scale theta of that Gamma distribution (GIGA's ``gamma_scale``)."""
+    dex_gp_sigma_m: float = 0.005
+    """``dex``: std of the additive Gaussian field at its grid nodes, m (GIGA's ``gp_sigma``; between the
+    nodes the bilinear upsampling averages them: 0.53-0.78 of this per pixel)."""
+    dex_gp_downsample: float = 4.0
+    """``dex``: the field's grid has int(H / this) x int(W / this) nodes (GIGA's ``gp_scale``: 120 x 160 for
+    640 x 480)."""
+    dex_gp_probability: float = 0.5
+    """``dex``: probability that a frame gets the additive field (GIGA's ``gp_rate``; the multiplicative
+    factor applies to every frame)."""
 
 
 @dataclass
@@ -152,6 +173,28 @@ class RegistrationConfig:
     """Voxel size of the clouds FPFH features are computed on, m (global registration)."""
     ransac_iterations: int = 100_000
     """RANSAC iterations of the global registration."""
+    min_target_points: int = 6
+    """Fewest points of the target the camera must see (after the workspace crop) for a registration to be
+    tried; fewer: the trial (or the clutter object) ends ``registration_failed``. 6: point-to-plane ICP
+    solves for six unknowns (three of rotation, three of translation) from one equation per point, so fewer
+    points leave the pose undetermined (global registration's RANSAC draws 3)."""
+    min_inliers: int = 6
+    """Fewest model points ICP's result aligns with an observed point within ``max_correspondence_m``
+    (fitness x the model points ICP used); fewer: ``registration_failed``. 6, as ``min_target_points``: ICP's
+    last step solved for the pose from these correspondences alone. At least 1: a fitness of 0 (no
+    correspondence at all: nothing the camera saw is where the registered model is) always fails."""
+    min_fitness: float = 0.0
+    """Lowest share of the model points ICP used that found a correspondence (Open3D's fitness, in [0, 1]);
+    below: ``registration_failed``. 0: no share is asked beyond ``min_inliers``, because a correct pose's
+    share falls with what hides the object from the camera (its own parts; neighbours in a clutter pile),
+    which says nothing of the pose; raise it to refuse poses fitted to a sliver of the object."""
+    centroid_margin_m: float = 0.015
+    """The registered pose fails (``registration_failed``) when the centroid of the target's observed points
+    lies farther from the registered model's centroid than the model's radius (its farthest point from its
+    centroid) plus this, m. Every point the camera sees of a correctly posed object lies on its surface, hence
+    within that radius of its centroid, and so does their mean: a correct pose never fails; a pose that left
+    the observed points behind (global registration or ICP converged on nothing, the identity) does. The
+    margin covers the depth noise and a correspondence's residual: ``max_correspondence_m``'s default."""
 
 
 @dataclass
@@ -202,6 +245,11 @@ DEPTH_NOISE_CONSTRAINTS = {
     "lateral_angle_px": [Interval(0, 20, unit="px")],
     "max_incidence_deg": [Interval(0, 90, unit="deg")],
     "edge_jump_m": [Interval(0, 10, "right", "m")],
+    "dex_gamma_shape": [Interval(0, None, "neither")],
+    "dex_gamma_scale": [Interval(0, None, "neither")],
+    "dex_gp_sigma_m": [Interval(0, 1, unit="m")],
+    "dex_gp_downsample": [Interval(1, 1000)],
+    "dex_gp_probability": [Interval(0, 1)],
 }
 REGISTRATION_CONSTRAINTS = {
     "prior": [Options(PRIORS)],
@@ -213,6 +261,10 @@ REGISTRATION_CONSTRAINTS = {
     "normal_radius_m": [Interval(0, 1, "right", "m")],
     "global_voxel_m": [Interval(0, 1, "right", "m")],
     "ransac_iterations": [Interval(1, 100_000_000, integer=True)],
+    "min_target_points": [Interval(3, None, integer=True)],
+    "min_inliers": [Interval(1, None, integer=True)],
+    "min_fitness": [Interval(0, 1)],
+    "centroid_margin_m": [Interval(0, 10, unit="m")],
 }
 PERCEPTION_CONSTRAINTS = {"source": [Options(SOURCES)]}
 """Allowed values of every ``perception`` key (see :mod:`graspexp.config.constraints`)."""

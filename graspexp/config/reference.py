@@ -204,6 +204,60 @@ def _options(group: str, keys: list[Key], options: list[str]) -> list[str]:
     return lines
 
 
+PROTOCOL_GROUP = "protocol"
+"""The group of the published benchmark protocols (``conf/protocol/<name>.yaml``, package ``_global_``): each
+selects options of other groups and sets their keys; its scene- and planner-dependent keys are in
+``conf/protocol/scene/<name>_<mode>.yaml`` and ``conf/protocol/planner/<name>_<planner>.yaml``, which
+``conf/config.yaml`` picks by interpolation once the choices are known."""
+PROTOCOL_PARTS = {"scene": "mode", "planner": "planner"}
+"""The protocol's sub-folders -> the group whose choice names their option (``<protocol>_<choice>``)."""
+
+
+def _sets(data: dict) -> tuple[list[str], list[str]]:
+    """(the group options, the key values) a ``_global_`` YAML option sets, as ``group=option`` and
+    ``key=value`` strings."""
+    groups = [
+        f"`{key.removeprefix('override').strip().lstrip('/')}={value}`"
+        for entry in data.get("defaults") or []
+        if isinstance(entry, dict)
+        for key, value in entry.items()
+    ]
+    values = [
+        f"`{k}={_show(v)}`" for k, v in _flat({k: v for k, v in data.items() if k != "defaults"}).items()
+    ]
+    return groups, values
+
+
+def protocol_section() -> list[str]:
+    """The ``protocol`` group's part of the reference: every option, the groups it selects and the keys it
+    sets, those that depend on the scene or the planner with their condition."""
+    base = Path(CONF_DIR) / PROTOCOL_GROUP
+    lines = [
+        "",
+        f"## `{PROTOCOL_GROUP}`",
+        "",
+        "A published benchmark protocol as one word (`conf/protocol/`): `protocol=NAME` selects the options "
+        "and sets the keys the protocol fixes; none by default. `mode=pile` / `mode=packed` still choose the "
+        "scene (the protocol's default is pile), and every key it sets stays overridable on the command line; "
+        "`python -m graspexp protocol=NAME --cfg job` shows them. "
+        f"Options: {', '.join(f'`{PROTOCOL_GROUP}={o}`' for o in group_options(PROTOCOL_GROUP))}.",
+        "",
+        "| option | when | selects | sets |",
+        "|---|---|---|---|",
+    ]
+    for option in group_options(PROTOCOL_GROUP):
+        groups, values = _sets(yaml.safe_load((base / f"{option}.yaml").read_text()) or {})
+        lines.append(f"| `{PROTOCOL_GROUP}={option}` | always | {', '.join(groups)} | {', '.join(values)} |")
+        for part, group in PROTOCOL_PARTS.items():
+            for path in sorted((base / part).glob(f"{option}_*.yaml")):
+                groups, values = _sets(yaml.safe_load(path.read_text()) or {})
+                when = f"`{group}={path.stem.removeprefix(option + '_')}`"
+                lines.append(
+                    f"| `{PROTOCOL_GROUP}={option}` | {when} | {', '.join(groups)} | {', '.join(values)} |"
+                )
+    return lines
+
+
 def render() -> str:
     """The whole reference page as Markdown."""
     out = [
@@ -241,6 +295,7 @@ def render() -> str:
                 "",
                 *_table([k for k in schema_keys(sub, f"{group}.") if k.dotted not in own]),
             ]
+    out += protocol_section()
     out += [
         "",
         "## `planner`",

@@ -45,6 +45,8 @@ RELATIONS = (
     ("perception.camera.min_range_m", "<", "perception.camera.max_range_m"),
 )
 """Pairs of keys whose values must keep this order."""
+RANGES = ("mode.object_scale",)
+"""Keys whose value is a range [min, max]: min must not exceed max."""
 URDF_OPTION = "urdf"
 """The gripper option that reads ``gripper.urdf`` (conf/gripper/urdf.yaml): without a file it has no
 geometry (a ``???`` in its YAML would not override the schema's None)."""
@@ -122,6 +124,13 @@ def _check_relations(cfg: DictConfig) -> None:
             raise ConfigError(f"{left}={a!r} is invalid: expected {op} {right}={b!r}")
 
 
+def _check_ranges(cfg: DictConfig) -> None:
+    for key in RANGES:
+        value = OmegaConf.select(cfg, key)
+        if value is not None and value[0] > value[1]:
+            raise ConfigError(f"{key}={list(value)!r} is invalid: expected [min, max] with min <= max")
+
+
 def _check_urdf_named(node: DictConfig) -> None:
     """The ``urdf`` gripper option without a ``gripper.urdf`` file: one line saying how to give it."""
     if isinstance(node, DictConfig) and node.get("urdf", None) is None and node.get("name") == URDF_OPTION:
@@ -145,6 +154,7 @@ def validate(cfg: DictConfig | Any) -> None:
     _check_urdf_named(OmegaConf.select(cfg, "gripper", throw_on_missing=False))
     _check_node(cfg, job.JobConfig, "")
     _check_relations(cfg)
+    _check_ranges(cfg)
     _check_split(cfg)
     _check_camera_extra(cfg)
 

@@ -29,13 +29,23 @@ class FailureReason(str, enum.Enum):
     """The object was still moving when the settle time cap (``sim.settle_max_s``) ran out: nothing is
     planned on a moving object, so the trial is neither a grasp's success nor its failure (the log's
     ``settle_timeout`` phase says how fast it still moved)."""
+    REGISTRATION_FAILED = "registration_failed"
+    """``perception.source=depth``: the camera saw too little of the object, or the pose registered from what
+    it saw fails a check of ``perception.registration`` (``min_target_points``, ``min_inliers``,
+    ``min_fitness``, ``centroid_margin_m``): nothing is planned on the prior or on the identity, so the trial
+    is a perception failure, not a grasp's (``TrialResult.detail`` gives the points seen and the fitness)."""
     ERROR = "error"
     """The trial raised; the message is in ``TrialResult.error``."""
 
 
+UNPLANNED = (FailureReason.NO_FEASIBLE_GRASP.value, FailureReason.REGISTRATION_FAILED.value)
+"""Reasons of trials that ended at planning, without a grasp (none found; no pose to plan on): a report's
+"planned grasps" leave them out."""
+
+
 @dataclass
 class TrialResult:
-    """One row of the results table; also the ``graspexp.TrialResult@4`` MCAP message."""
+    """One row of the results table; also the ``graspexp.TrialResult@5`` MCAP message."""
 
     dataset: str
     object: str
@@ -80,6 +90,11 @@ class TrialResult:
     ``perception.registration.max_correspondence_m`` (Open3D's fitness), in [0, 1]."""
     registration_cpu_s: float = float("nan")
     """... CPU time of the registration (all threads), s."""
+    detail: str = ""
+    """Why the trial failed, one line: the failed check's own words (for ``registration_failed`` the points
+    the camera saw of the object and the registration's fitness; for ``no_feasible_grasp`` the planner's
+    reason, e.g. a view-based planner's "the camera saw N points"); "" on success, for ``error`` (see
+    ``error``) and in logs written before the field existed (``graspexp.TrialResult@4`` and older)."""
 
     def to_dict(self) -> dict:
         return asdict(self)

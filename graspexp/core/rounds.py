@@ -9,14 +9,24 @@ from dataclasses import asdict, dataclass, field
 
 
 class RoundEnd(str, enum.Enum):
-    """Why a round ended (VGN's three rules, and an error)."""
+    """Why a round ended (VGN's three rules, the single-object rules that apply to a heap, and an error)."""
 
     CLEARED = "cleared"
-    """No object is left on the table."""
+    """Every object placed was removed (at least one was placed)."""
     NO_GRASP = "no_grasp"
-    """The planner found no grasp on any object left."""
+    """The planner found no grasp on any object left, or no object left could be registered from the camera
+    (``perception.source=depth``): the last row's reason says which (``no_feasible_grasp`` or
+    ``registration_failed``)."""
     FAILURE_LIMIT = "failure_limit"
     """``mode.max_consecutive_failures`` attempts in a row failed."""
+    NOT_AT_REST = "not_at_rest"
+    """The heap was still moving when the planner was to look (``sim.settle_max_s`` ran out after the placing
+    or after an attempt): nothing is planned on a moving heap, so the round stops there, as a single-object
+    trial does; its last row (not executed, reason ``not_at_rest``) names the object moving fastest. No
+    attempt is added to GSR; the objects left count as not removed in DR."""
+    NOTHING_PLACED = "nothing_placed"
+    """No object came to rest inside the workspace: nothing to grasp (not ``cleared``); the round adds nothing
+    to GSR or DR and is not counted among the rounds the planner ran."""
     ERROR = "error"
     """The round raised; the message is in ``RoundResult.error``."""
 
@@ -44,9 +54,10 @@ class AttemptResult:
     n_planned: int
     """Plans made for this attempt (objects planned for)."""
     plan_s: float
-    """Wall time of every plan made for the attempt (the scene's planning latency), s."""
+    """Wall time of every plan made for the attempt (the scene's planning latency), s; NaN when none was made
+    (``not_at_rest``, ``registration_failed``)."""
     plan_cpu_s: float
-    """CPU time of the planning thread over the same plans, s."""
+    """CPU time of the planning thread over the same plans, s (NaN as ``plan_s``)."""
     grasp_cost: float = float("nan")
     grasp_width_m: float = float("nan")
     n_feasible: int = 0

@@ -4,8 +4,9 @@ Run directory::
 
     trials/<object>/<NNN>.mcap               one log per trial (the source of truth)
     trials/.quarantine/<object>/<name>.<UTC>  files resume moved aside (never deleted)
-    results.csv                              one row per trial (a cache rebuilt from the logs at the end)
+    results.csv                              one row per trial (rebuilt from the logs and its own rows)
     summary.md                               the per-object success table printed at the end
+    run.json                                 what made the tables' rows: config, meshes, clutter pool
     .hydra/{config,hydra,overrides}.yaml     Hydra's record of the accepted run
     .graspexp.lock, .graspexp.lock.holder    the job's lock and who holds it
 
@@ -31,6 +32,8 @@ ATTEMPTS_CSV = "attempts.csv"
 """One row per grasp attempt of the run's clutter rounds (:class:`graspexp.core.rounds.AttemptResult`)."""
 SUMMARY_MD = "summary.md"
 """The run's per-object success table (markdown)."""
+RUN_RECORD = "run.json"
+"""What made the rows of the run's tables (:mod:`graspexp.run.run_record`): the config, the meshes, the pool."""
 HYDRA_DIR = ".hydra"
 """Hydra's record of an accepted run: ``config.yaml``, ``hydra.yaml``, ``overrides.yaml``."""
 HYDRA_FILES = ("config.yaml", "hydra.yaml", "overrides.yaml")
@@ -99,6 +102,11 @@ def quarantine_path(run_dir: Path | str, log: Path, stamp: str) -> Path:
 def results_csv(run_dir: Path | str) -> Path:
     """The run's results table."""
     return Path(run_dir) / RESULTS_CSV
+
+
+def run_record_path(run_dir: Path | str) -> Path:
+    """The run's record of what made its tables' rows (:data:`RUN_RECORD`)."""
+    return Path(run_dir) / RUN_RECORD
 
 
 def summary_md(run_dir: Path | str) -> Path:

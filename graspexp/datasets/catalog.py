@@ -5,7 +5,8 @@ Four layouts (``dataset.layout``; None takes the catalogued set's own):
 - ``ycb``: ``<id>/google_16k/textured.obj`` (official archives) or ``models/<id>/textured.obj`` (YCB-Video),
   metres, the published masses of :mod:`graspexp.datasets.ycb_objects`;
 - ``bop``: any BOP set (:mod:`graspexp.datasets.bop`), millimetres; ``linemod`` is the catalogued instance;
-- ``folder``: your own meshes and URDFs (:mod:`graspexp.datasets.folder`);
+- ``folder``: your own meshes and URDFs (:mod:`graspexp.datasets.folder`); ``vgn_pile`` and ``vgn_packed``
+  are catalogued instances (VGN's and GIGA's clutter test objects, :mod:`graspexp.datasets.vgn_clutter`);
 - ``primitives``: procedural shapes (:mod:`graspexp.datasets.primitives`).
 
 Nothing here reads a mesh; :mod:`graspexp.datasets.loader` does that.
@@ -19,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from graspexp.datasets import bop, folder
+from graspexp.datasets import bop, folder, vgn_clutter
 from graspexp.datasets.errors import DatasetError
 from graspexp.datasets.source import MeshPart, ObjectSource
 from graspexp.datasets.ycb_objects import GOOGLE_16K_EXTENTS_MM, GOOGLE_16K_FACES, YCB_MASS_KG
@@ -104,6 +105,17 @@ DATASETS: dict[str, DatasetSpec] = {
         subfolder="linemod",
         downloadable=True,
     ),
+    **{
+        f"vgn_{scene}": DatasetSpec(
+            name=f"vgn_{scene}",
+            layout="folder",
+            catalogue=vgn_clutter.object_names(scene),
+            default_objects=vgn_clutter.object_names(scene),
+            subfolder=vgn_clutter.set_folder(scene),
+            downloadable=True,
+        )
+        for scene in vgn_clutter.SCENES
+    },
     "primitives": DatasetSpec(
         name="primitives",
         layout="primitives",
@@ -253,6 +265,8 @@ def candidate_paths(cfg: Any, name: str) -> list[Path]:
         models, ids = _bop_models(cfg)
         return [bop.model_file(models, ids[name])]
     if layout == "folder":
+        if catalogued(cfg) is not None:  # a catalogued set of URDFs: its names are known, nothing is scanned
+            return [dataset_dir(cfg) / f"{name}.urdf"]
         return [folder.scan(dataset_dir(cfg))[name].file]
     return []
 
@@ -280,6 +294,9 @@ def object_source(cfg: Any, name: str) -> ObjectSource:
     if layout == "primitives":
         check_object_name(cfg, name)
         return ObjectSource(name=name, parts=())
+    if layout == "folder" and catalogued(cfg) is not None:
+        urdf = mesh_path(cfg, name)  # the catalogued set's URDF, or the error naming the download command
+        return folder.object_source(urdf.parent, folder.FolderEntry(name, urdf, True), str(cfg.units))
     if layout == "folder":
         base = dataset_dir(cfg)
         entries = folder.scan(base)
@@ -334,6 +351,6 @@ def dataset_objects(cfg: Any) -> list[str]:
 
 def available_objects(cfg: Any) -> list[str]:
     """The names of :func:`dataset_objects` whose mesh files exist under the data root."""
-    if layout_of(cfg) in ("primitives", "folder"):
+    if layout_of(cfg) == "primitives" or (layout_of(cfg) == "folder" and catalogued(cfg) is None):
         return dataset_objects(cfg)
     return [n for n in dataset_objects(cfg) if any(p.is_file() for p in candidate_paths(cfg, n))]

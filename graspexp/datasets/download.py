@@ -1,15 +1,18 @@
-"""Fetch and verify the real object meshes (YCB google_16k, BOP LINEMOD) into the data root
-(``python -m graspexp download``: :func:`download_dataset`).
+"""Fetch and verify the real object meshes (YCB google_16k, BOP LINEMOD, VGN's and GIGA's clutter test
+objects) into the data root (``python -m graspexp download``: :func:`download_dataset`).
 
 Layout written (what :func:`graspexp.datasets.load_object` reads)::
 
     <root>/ycb/<id>/google_16k/textured.obj      from <YCB URL><id>_google_16k.tgz
     <root>/linemod/models/obj_0000NN.ply         from <LINEMOD URL>lm_models.zip (millimetres)
+    <root>/vgn_clutter/<scene>/test/<file>       from <VGN_CLUTTER URL><scene>/test/<file> (vgn_pile, vgn_packed)
     <root>/.downloads/                           the archives (kept, so a re-run only verifies)
     <root>/.graspexp-hashes.json                 SHA-256 of every archive without a published hash
 
-Base URLs: ``--base-url``, else env ``GRASPEXP_YCB_URL`` / ``GRASPEXP_LINEMOD_URL``, else the official
-hosts. YCB publishes no checksums: the SHA-256 of an archive is recorded on its first download, once the
+Base URLs: ``--base-url``, else env ``GRASPEXP_YCB_URL`` / ``GRASPEXP_LINEMOD_URL`` /
+``GRASPEXP_VGN_CLUTTER_URL``, else the official hosts (for the clutter objects: the pinned commit of
+``supersglzc/GIGA``, :data:`graspexp.datasets.vgn_clutter.URL`; every file is checked against the manifest
+graspexp carries, :data:`graspexp.datasets.vgn_clutter.MANIFEST`). YCB publishes no checksums: the SHA-256 of an archive is recorded on its first download, once the
 archive opens as a tar file (an HTML error page is refused and deleted, nothing recorded), and every
 later download must match it; to reset a recorded hash, delete its entry from the registry file.
 LINEMOD is checked against the published BOP SHA-256. One download runs per data root at a time (a
@@ -36,13 +39,20 @@ from pathlib import Path, PurePosixPath
 import pooch
 from filelock import FileLock, Timeout
 
+from graspexp.datasets import vgn_clutter
 from graspexp.datasets.catalog import LINEMOD_IDS, YCB_MASS_KG
 from graspexp.datasets.errors import DatasetError
 
 YCB_URL = "https://ycb-benchmarks.s3.amazonaws.com/data/google/"
 LINEMOD_URL = "https://huggingface.co/datasets/bop-benchmark/datasets/resolve/main/lm/"
-URL_ENV = {"ycb": "GRASPEXP_YCB_URL", "linemod": "GRASPEXP_LINEMOD_URL"}
-DEFAULT_URL = {"ycb": YCB_URL, "linemod": LINEMOD_URL}
+URL_ENV = {
+    "ycb": "GRASPEXP_YCB_URL",
+    "linemod": "GRASPEXP_LINEMOD_URL",
+    "vgn_clutter": "GRASPEXP_VGN_CLUTTER_URL",
+}
+DEFAULT_URL = {"ycb": YCB_URL, "linemod": LINEMOD_URL, "vgn_clutter": vgn_clutter.URL}
+VGN_CLUTTER_SETS = {f"vgn_{scene}": scene for scene in vgn_clutter.SCENES}
+"""The catalogued datasets of the clutter test objects -> their scene (the set's folder)."""
 LINEMOD_ARCHIVE = "lm_models.zip"
 LINEMOD_SHA256 = "cb5b5366ce620d41800c7941c2e770036c7c13c178514fa07e6a89fda5ff0e7f"
 """Published SHA-256 of BOP ``lm/lm_models.zip``."""
@@ -293,6 +303,36 @@ def download_linemod(
     return models
 
 
+def download_vgn_clutter(
+    root: Path | str,
+    scene: str,
+    objects: Sequence[str],
+    *,
+    url: str | None = None,
+    progress: bool = True,
+) -> list[Path]:
+    """Fetch the files of ``objects`` of the clutter test set of ``scene`` (``pile`` or ``packed``) into
+    ``<root>/vgn_clutter/<scene>/test/``, each from ``<base URL><scene>/test/<file>`` and checked against its
+    SHA-256 in :data:`graspexp.datasets.vgn_clutter.MANIFEST` (a file already there with the right hash is
+    kept; one that differs is fetched again; a download that differs is refused). Returns the URDF paths."""
+    root = Path(root).expanduser()
+    names = vgn_clutter.object_names(scene)
+    unknown = [n for n in objects if n not in names]
+    if unknown:
+        raise DatasetError(
+            f"unknown object(s) {unknown} in dataset 'vgn_{scene}'; valid names: {', '.join(names)}"
+        )
+    hashes = vgn_clutter.scene_files(scene)
+    dest = root / vgn_clutter.set_folder(scene)
+    base = base_url("vgn_clutter", url) + f"{scene}/test/"
+    urdfs = []
+    for name in objects:
+        for fname in vgn_clutter.object_files(name):
+            fetch(base + fname, dest, fname, hashes[fname], progress=progress)
+        urdfs.append(dest / f"{name}.urdf")
+    return urdfs
+
+
 def download_dataset(
     dataset: str,
     root: Path,
@@ -302,11 +342,14 @@ def download_dataset(
     sha256: str | None = None,
     progress: bool = False,
 ) -> tuple[list[Path], list[str]]:
-    """Download and verify ``objects`` of ``dataset`` (``ycb`` or ``linemod``) into data root ``root``:
-    (the model files ready, the names of ``objects`` the LINEMOD archive lacks). ``sha256``: the expected
-    hash of the LINEMOD archive (default the published one). Raises :class:`DatasetError`."""
+    """Download and verify ``objects`` of ``dataset`` (``ycb``, ``linemod``, ``vgn_pile`` or ``vgn_packed``)
+    into data root ``root``: (the model files ready, the names of ``objects`` the LINEMOD archive lacks).
+    ``sha256``: the expected hash of the LINEMOD archive (default the published one). Raises
+    :class:`DatasetError`."""
     if dataset == "ycb":
         return download_ycb(root, objects, url=url, progress=progress), []
+    if dataset in VGN_CLUTTER_SETS:
+        return download_vgn_clutter(root, VGN_CLUTTER_SETS[dataset], objects, url=url, progress=progress), []
     paths = download_linemod(root, url=url, sha256=sha256 or LINEMOD_SHA256, progress=progress)
     have = {p.name for p in paths}
     return paths, [n for n in objects if f"obj_{LINEMOD_IDS[n]:06d}.ply" not in have]

@@ -10,11 +10,17 @@ the return (depth, id, angle) of the pixel offset by a Gaussian (du, dv) of std 
 rounded; (3) axial noise: Gaussian of std ``sigma_z(z, theta)`` added to the depth; (4) pixels whose depth
 differs from a 4-neighbour's by more than ``edge_jump_m`` (or that border a pixel without return) lose their
 return. All draws come from the ``rng`` passed in (seeded per trial).
+
+``dex`` (:func:`dex_noise`): the noise of GIGA's simulated clutter benchmark (Jiang et al., RSS 2021,
+``apply_dex_noise`` in supersglzc/GIGA ``src/vgn/utils/misc.py``): the frame's depth times one Gamma factor,
+then, in a share of the frames, plus a Gaussian field drawn on a coarse grid and bilinearly upsampled. Draws,
+in GIGA's order: the factor, one uniform (whether the field is added), the grid's normals (only when it is).
 """
 
 from collections.abc import Callable
 
 import numpy as np
+from scipy import ndimage
 
 from graspexp.config.perception import DepthNoiseConfig
 
@@ -111,4 +117,40 @@ def nguyen_noise(
             edge[:, 1:] |= jump
             edge[:, :-1] |= jump
     out = np.where(edge | (out <= 0), 0.0, out)
+    return out.astype(np.float32), np.where(out > 0, ids, 0).astype(np.int32)
+
+
+def upsample_bilinear(grid: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """``grid`` (h, w) resized to ``shape`` (H, W) by bilinear interpolation between pixel centres, zero beyond
+    the grid's edge: what ``skimage.transform.resize(grid, shape, order=1, mode="constant",
+    anti_aliasing=False)`` returns (scipy's zoom in grid mode, as scikit-image calls it)."""
+    zoom = (shape[0] / grid.shape[0], shape[1] / grid.shape[1])
+    out = ndimage.zoom(grid, zoom, order=1, mode="grid-constant", cval=0.0, grid_mode=True)
+    if out.shape != tuple(shape):
+        raise ValueError(f"upsampling {grid.shape} to {shape} gave {out.shape}")
+    return out
+
+
+@noise_model("dex")
+def dex_noise(
+    cfg: DepthNoiseConfig,
+    depth: np.ndarray,
+    ids: np.ndarray,
+    cos_incidence: np.ndarray,
+    *,
+    rng: np.random.Generator,
+) -> tuple[np.ndarray, np.ndarray]:
+    """GIGA's dex noise (module doc) on the exact frame ``depth`` (float64 m): ``depth * g`` with ``g ~
+    Gamma(dex_gamma_shape, dex_gamma_scale)`` one factor for the frame, then with probability
+    ``dex_gp_probability`` plus ``dex_gp_sigma_m`` times a standard normal grid of int(H / d) x int(W / d)
+    nodes (``d = dex_gp_downsample``) upsampled bilinearly (:func:`upsample_bilinear`). Pixels without a
+    return keep none; a depth pushed to 0 or below returns nothing."""
+    h, w = depth.shape
+    ret = depth > 0
+    out = depth * rng.gamma(cfg.dex_gamma_shape, cfg.dex_gamma_scale)
+    if rng.random() < cfg.dex_gp_probability:
+        d = float(cfg.dex_gp_downsample)
+        grid = rng.standard_normal((max(1, int(h / d)), max(1, int(w / d)))) * cfg.dex_gp_sigma_m
+        out = out + upsample_bilinear(grid, (h, w))
+    out = np.where(ret & (out > 0), out, 0.0)
     return out.astype(np.float32), np.where(out > 0, ids, 0).astype(np.int32)

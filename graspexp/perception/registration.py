@@ -36,6 +36,19 @@ class Registration:
     method: str
     cpu_s: float
     wall_s: float
+    n_points: int = 0
+    """Observed points of the target the registration was given."""
+    inliers: int = 0
+    """Model points ICP's result aligned with an observed point within ``max_correspondence_m``."""
+    failure: str = ""
+    """Why ``pose`` is no pose of the object ("": it is): the check of :func:`failure` that failed, one line
+    with the points seen and the fitness. ``pose`` is then only what the registration ended at (the prior,
+    or the identity, when it did not run) and is never to be planned on."""
+
+    @property
+    def ok(self) -> bool:
+        """Whether the pose passed every check (:func:`failure`)."""
+        return not self.failure
 
 
 @functools.cache
@@ -152,12 +165,14 @@ def register(
     rng: np.random.Generator,
 ) -> Registration:
     """The object's pose from its observed points (module doc): ICP from ``prior`` (4, 4), or global
-    registration then ICP when ``prior`` is None. model_* : (N, 3) object frame; observed* : (M, 3) world;
-    eyes : (V, 3) the cameras' positions, world, m. Fewer than 3 observed points: the prior (or identity)
-    with fitness 0."""
+    registration then ICP when ``prior`` is None, and the verdict of :func:`failure` on it. model_* : (N, 3)
+    object frame; observed* : (M, 3) world; eyes : (V, 3) the cameras' positions, world, m. Fewer than
+    ``cfg.min_target_points`` observed points: nothing runs (``pose`` the prior, or the identity; fitness 0;
+    ``failure`` says so)."""
     wall0, cpu0 = time.perf_counter(), time.process_time()
     method = "icp" if prior is not None else "global+icp"
-    if len(observed) < 3:
+    inliers = 0
+    if len(observed) < max(3, int(cfg.min_target_points)):
         pose, fitness, rmse = (
             (np.eye(4) if prior is None else np.array(prior, dtype=float)),
             0.0,
@@ -181,6 +196,8 @@ def register(
         result = icp(src, observed, observed_normals, init, cfg)
         pose = np.array(result.transformation)
         fitness, rmse = float(result.fitness), float(result.inlier_rmse)
+        inliers = len(result.correspondence_set)
+    why = failure(cfg, observed, model_points, pose, fitness, inliers)
     return Registration(
         pose=pose,
         fitness=fitness,
@@ -188,7 +205,45 @@ def register(
         method=method,
         cpu_s=time.process_time() - cpu0,
         wall_s=time.perf_counter() - wall0,
+        n_points=len(observed),
+        inliers=inliers,
+        failure=why,
     )
+
+
+def failure(
+    cfg: RegistrationConfig,
+    observed: np.ndarray,
+    model_points: np.ndarray,
+    pose: np.ndarray,
+    fitness: float,
+    inliers: int,
+) -> str:
+    """Why the registered ``pose`` (4, 4) is not the object's pose, one line naming the points the camera saw
+    and the fitness; "" when it passes every check of ``cfg`` (in this order): at least
+    ``min_target_points`` observed points (M, 3 world), at least ``min_inliers`` model points aligned, a
+    fitness of at least ``min_fitness``, and the observed points' centroid within the registered model's
+    radius plus ``centroid_margin_m`` of its centroid (``model_points`` (N, 3) object frame; see
+    :class:`~graspexp.config.perception.RegistrationConfig` for why each cannot refuse a correct pose)."""
+    key = "perception.registration"
+    seen = f"the camera saw {len(observed)} points of the target"
+    if len(observed) < cfg.min_target_points:
+        return f"{seen}, fewer than {key}.min_target_points={cfg.min_target_points}"
+    fit = f"{seen}; ICP aligned {inliers} model points (fitness {fitness:.3f})"
+    if inliers < cfg.min_inliers:
+        return f"{fit}, fewer than {key}.min_inliers={cfg.min_inliers}"
+    if fitness < cfg.min_fitness:
+        return f"{fit}, below {key}.min_fitness={cfg.min_fitness:g}"
+    model = np.asarray(model_points, dtype=np.float64)
+    centre = model.mean(axis=0)
+    radius = float(np.sqrt(((model - centre) ** 2).sum(axis=1).max()))
+    gap = float(np.linalg.norm(pose[:3, :3] @ centre + pose[:3, 3] - np.asarray(observed).mean(axis=0)))
+    if gap > radius + cfg.centroid_margin_m:
+        return (
+            f"{fit}; the registered model's centroid is {1e3 * gap:.0f} mm from theirs, farther than its "
+            f"radius {1e3 * radius:.0f} mm + {key}.centroid_margin_m={cfg.centroid_margin_m:g} m"
+        )
+    return ""
 
 
 def pose_errors(estimate: np.ndarray, truth: np.ndarray, model_points: np.ndarray) -> dict[str, float]:

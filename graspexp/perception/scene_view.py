@@ -33,7 +33,10 @@ class Perceived:
     pose : (4, 4) world pose of the object the planner is given. prior : (4, 4) the noisy true pose (the
     registration's start with ``perception.source=depth``). observation : what the camera saw, or None.
     registration : the :class:`graspexp.perception.registration.Registration`, or None. errors : pose
-    errors of ``pose`` against the truth (``trans_mm``, ``rot_deg``, ``adds_mm``) when a pose was registered.
+    errors of the registered pose against the truth (``trans_mm``, ``rot_deg``, ``adds_mm``) when a
+    registration ran. failure : why no pose could be registered, when the planner plans on the pose
+    (:func:`plans_on_pose`; "": one was, none was asked for, or the planner plans from the camera's cloud);
+    then ``pose`` is not the object's and nothing may be planned on it (:attr:`ok`).
     """
 
     pose: np.ndarray
@@ -41,6 +44,17 @@ class Perceived:
     observation: Observation | None = None
     registration: object | None = None
     errors: dict[str, float] = field(default_factory=dict)
+    failure: str = ""
+
+    @property
+    def ok(self) -> bool:
+        """Whether ``pose`` may be planned on (the registration, if any, passed its checks)."""
+        return not self.failure
+
+
+class RegistrationFailed(ValueError):
+    """``perception.source=depth`` registered no pose of the object (:attr:`Perceived.failure`): a plan
+    without a simulated trial (``graspexp plan``, the planner bench) refuses with this one line."""
 
 
 def perceived_pose(
@@ -60,6 +74,16 @@ def perceived_pose(
 def wants_camera(cfg: JobConfig) -> bool:
     """Whether the trial renders the camera: ``perception.source=depth``, or a planner that reads it."""
     return cfg.perception.source == "depth" or get_plugin(cfg.planner.name).plugin.needs_observation
+
+
+def plans_on_pose(cfg: JobConfig) -> bool:
+    """Whether the planner plans on the object's pose (its model's cloud at that pose, the neighbours' at
+    theirs): every planner but those that read the camera's output (``needs_observation``: ``antipodal_view``,
+    ``vgn``), which plan from what the camera saw and say themselves when it saw too little. With
+    ``perception.source=depth``, a failed registration stops the first kind only (``registration_failed``);
+    the second is not told a pose it would not use (its trials record the failure's fitness, no pose
+    error)."""
+    return not get_plugin(cfg.planner.name).plugin.needs_observation
 
 
 def scene_bodies(
@@ -101,7 +125,10 @@ def perceive(
         cfg.perception, obs, model.points, model.normals, start, rng=rng_for(trial_seed, "registration")
     )
     errors = pose_errors(reg.pose, true_pose, model.points)
-    return Perceived(pose=reg.pose, prior=prior, observation=obs, registration=reg, errors=errors)
+    failure = reg.failure if plans_on_pose(cfg) else ""
+    return Perceived(
+        pose=reg.pose, prior=prior, observation=obs, registration=reg, errors=errors, failure=failure
+    )
 
 
 def slot_id(slot: int) -> int:
@@ -114,18 +141,21 @@ def slot_id(slot: int) -> int:
 class ScenePerceived:
     """The planner's view of a clutter scene before one attempt.
 
-    poses : slot -> (4, 4) world pose the planner is given for that object. priors : slot -> (4, 4) the
-    noisy true pose (the registration's start; ``poses`` itself without ``perception.source=depth``).
-    observation : what the camera saw of the whole scene (every object, id :func:`slot_id`), ``target_id``
-    unset (0): each plan request gets a copy naming its target; None without a camera. errors : slot ->
-    pose errors of the registered pose (``trans_mm``, ``rot_deg``, ``adds_mm``, ``fitness``); empty
-    unless ``perception.source=depth``.
+    poses : slot -> (4, 4) world pose the planner is given for that object; a slot whose registration
+    failed has none when the planner plans on poses (:func:`plans_on_pose`; it is in ``failed``). priors : slot -> (4, 4) the noisy true pose (the registration's
+    start; ``poses`` itself without ``perception.source=depth``). observation : what the camera saw of the
+    whole scene (every object, id :func:`slot_id`), ``target_id`` unset (0): each plan request gets a copy
+    naming its target; None without a camera. errors : slot -> pose errors of the registered pose
+    (``trans_mm``, ``rot_deg``, ``adds_mm``; NaN for a failed slot) and its ``fitness``; empty unless
+    ``perception.source=depth``. failed : slot -> why no pose of it was registered
+    (:attr:`graspexp.perception.registration.Registration.failure`).
     """
 
     poses: dict[int, np.ndarray]
     priors: dict[int, np.ndarray]
     observation: Observation | None = None
     errors: dict[int, dict[str, float]] = field(default_factory=dict)
+    failed: dict[int, str] = field(default_factory=dict)
 
 
 def perceive_scene(
@@ -138,7 +168,8 @@ def perceive_scene(
     support at ``table_z``: each pose the noisy truth (``perception.noise``, drawn per slot from ``seed``);
     with a camera (:func:`wants_camera`) one observation of every object at its true pose, and with
     ``perception.source=depth`` each object's pose registered from it (its own points only: what its
-    neighbours hide is missing) from its noisy prior, as :func:`perceive` does for one object."""
+    neighbours hide is missing) from its noisy prior, as :func:`perceive` does for one object; an object
+    whose registration fails its checks is in ``failed``, and gets no pose when the planner plans on poses."""
     noise = cfg.perception.noise
     priors = {
         slot: perceived_pose(true, noise.trans_mm, noise.rot_deg, rng_for(seed, "noise", slot))
@@ -154,7 +185,8 @@ def perceive_scene(
     obs = observe(cfg.perception, meshes, boxes, table_z, 0, rng=rng_for(seed, "camera"))
     if cfg.perception.source != "depth":
         return ScenePerceived(priors, priors, obs)
-    poses, errors = {}, {}
+    poses, errors, failed = {}, {}, {}
+    on_pose = plans_on_pose(cfg)
     for slot, (model, true) in objects.items():
         start = None if cfg.perception.registration.prior == "none" else priors[slot]
         reg = estimate_pose(
@@ -165,6 +197,14 @@ def perceive_scene(
             start,
             rng=rng_for(seed, "registration", slot),
         )
-        poses[slot] = reg.pose
-        errors[slot] = {**pose_errors(reg.pose, true, model.points), "fitness": reg.fitness}
-    return ScenePerceived(poses, priors, obs, errors)
+        if reg.ok or not on_pose:
+            poses[slot] = reg.pose
+        if reg.ok:
+            errors[slot] = {**pose_errors(reg.pose, true, model.points), "fitness": reg.fitness}
+        else:
+            failed[slot] = reg.failure
+            errors[slot] = {
+                **dict.fromkeys(("trans_mm", "rot_deg", "adds_mm"), np.nan),
+                "fitness": reg.fitness,
+            }
+    return ScenePerceived(poses, priors, obs, errors, failed)

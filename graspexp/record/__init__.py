@@ -3,7 +3,7 @@
 Topics (log_time = simulation time in ns): ``/tf`` foxglove.FrameTransforms, ``/scene``
 foxglove.SceneUpdate, ``/contacts`` foxglove.PointCloud and ``/grasp_pose`` foxglove.PoseInFrame (protobuf,
 Foxglove's schemas, written by ``foxglove-sdk``); ``/grasp`` graspexp.PlannedGrasp@1, ``/phase``
-graspexp.Phase@1, ``/result`` graspexp.TrialResult@4 (JSON, our own JSON Schemas). The scene entities are
+graspexp.Phase@1, ``/result`` graspexp.TrialResult@5 (JSON, our own JSON Schemas). The scene entities are
 built by :mod:`graspexp.record.scene` (imported on its own: it needs the simulator's geometry).
 """
 

@@ -37,11 +37,17 @@ CAMERA_CALIBRATION = "foxglove.CameraCalibration"
 PERCEPTION = "graspexp.Perception@1"
 PLANNED_GRASP = "graspexp.PlannedGrasp@1"
 PHASE = "graspexp.Phase@1"
-TRIAL_RESULT = "graspexp.TrialResult@4"
+TRIAL_RESULT = "graspexp.TrialResult@5"
 ROUND_RESULT = "graspexp.RoundResult@1"
-READABLE_RESULTS = (TRIAL_RESULT, "graspexp.TrialResult@3", "graspexp.TrialResult@2")
-"""/result schemas the readers accept: @3 is @4 without the pose-registration fields (then NaN: no pose
-was registered), @2 is @3 without ``at_rest`` (then True: the cap was not checked)."""
+READABLE_RESULTS = (
+    TRIAL_RESULT,
+    "graspexp.TrialResult@4",
+    "graspexp.TrialResult@3",
+    "graspexp.TrialResult@2",
+)
+"""/result schemas the readers accept: @4 is @5 without ``detail`` (then "": no reason's words were kept),
+@3 is @4 without the pose-registration fields (then NaN: no pose was registered), @2 is @3 without
+``at_rest`` (then True: the cap was not checked)."""
 
 TOPIC_SCENE = "/scene"
 TOPIC_TF = "/tf"

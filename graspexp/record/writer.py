@@ -311,7 +311,7 @@ class TrialWriter:
         self._json(S.TOPIC_PHASE, t_s, to_json_value(msg))
 
     def result(self, t_s: float, result: Mapping[str, Any] | Any) -> None:
-        """/result, graspexp.TrialResult@4: ``TrialResult.to_dict()`` (a TrialResult is accepted too).
+        """/result, graspexp.TrialResult@5: ``TrialResult.to_dict()`` (a TrialResult is accepted too).
 
         NaN floats are written as null and read back as NaN.
         """

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from graspexp.core.outcome import UNPLANNED
 from graspexp.core.rounds import RoundResult
 from graspexp.report.compare import FC_MU, check_same_drops, render_markdown
 from graspexp.report.compare import success_by_noise as noise_success_table
@@ -59,7 +60,7 @@ def ranking(df: pd.DataFrame, dataset: str, settings: list[str]) -> pd.DataFrame
         for s in settings:
             mode, rot = s.split("/")
             row[s] = _success(g[(g["mode"] == mode) & (g["rot"] == rot)])
-        planned = g[g["reason"] != "no_feasible_grasp"]
+        planned = g[~g["reason"].isin(UNPLANNED)]
         touched = int(g["contacts"].sum())
         row["in-area contact %"] = f"{100 * g['contacts_in_area'].sum() / touched:.0f}" if touched else "n/a"
         held = g[g["contacts"] > 0]

@@ -30,7 +30,7 @@ from graspexp.report.gallery import draw_trial, write_gallery
 from graspexp.report.paper import PLANNER_RUNTIME_S
 from graspexp.report.pose_error import success_by_pose_error
 from graspexp.report.render import display_frame, fmt_pct, footnotes, latex, markdown
-from graspexp.report.round_tables import clutter_markdown, clutter_table, find_rounds
+from graspexp.report.round_tables import clutter_markdown, clutter_table, collect_rounds
 from graspexp.report.tables import (
     IN_AREA_COLUMN,
     STRICT_SLIP_M,
@@ -59,10 +59,13 @@ class Report:
 
 def build_report(root: Path | str, progress: bool = True) -> Report:
     """Collect every trial log below ``root`` and build all tables (nothing is written); the held trials'
-    logs are read again for the in-area criterion (``progress``: a progress bar on stderr)."""
+    logs are read again for the in-area criterion (``progress``: a progress bar on stderr). The clutter rounds
+    come from their logs or their tables (:func:`graspexp.report.round_tables.collect_rounds`); a table refused
+    by its schema is listed with the unreadable logs."""
     col = collect(root)
     df = col.results
-    rounds = find_rounds(root)
+    rounds, bad_rounds = collect_rounds(root)
+    col.unreadable += bad_rounds
     if df.empty:
         return Report(col, [], pd.DataFrame(), pd.DataFrame(), pd.DataFrame(), [], rounds)
     df[IN_AREA_COLUMN] = held_in_area(df, progress)
@@ -205,10 +208,11 @@ def write_report(report: Report, out_dir: Path | str, gallery_per_reason: int = 
     out.mkdir(parents=True, exist_ok=True)
     col = report.collected
     n_logs = len(col.results) + len(col.unreadable) + len(col.duplicates)
+    rounds = f", {len(report.rounds)} clutter rounds read" if report.rounds else ""
     md = [
         f"# graspexp report: {col.root}",
         "",
-        f"{n_logs + len(col.not_run)} trial logs found, {len(col.results)} results read"
+        f"{n_logs + len(col.not_run)} trial logs found, {len(col.results)} results read{rounds}"
         + (f", {len(col.not_run)} trials not run (listed below)." if len(col.not_run) else "."),
         "",
     ]

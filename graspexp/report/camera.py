@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 
 from graspexp.config.plugins import learned_planners
+from graspexp.core.outcome import FailureReason
 from graspexp.report.collect import collect
 from graspexp.report.paper import BASELINES, SETTING_LABELS, SETTINGS, TABLE1
 from graspexp.report.pose_error import success_by_pose_error
@@ -51,12 +52,14 @@ def _cell(g: pd.DataFrame) -> str:
 
 
 def _registered(df: pd.DataFrame) -> pd.Series:
-    """Trials of the registered columns: a registered pose (finite ``pose_adds_mm``), or a run with a prior
-    (``perception.noise`` non-zero: the sweep runs the exact-pose columns without noise), which counts a
+    """Trials of the registered columns: a registered pose (finite ``pose_adds_mm``), a registration that
+    failed (``registration_failed``: a failure of that column, never of the exact pose's), or a run with a
+    prior (``perception.noise`` non-zero: the sweep runs the exact-pose columns without noise), which counts a
     trial whose object fell off the support before any registration too."""
     adds = df["pose_adds_mm"].astype(float) if "pose_adds_mm" in df else pd.Series(np.nan, index=df.index)
     prior = (df.get("trans_mm", 0.0) != 0) | (df.get("rot_deg", 0.0) != 0)
-    return np.isfinite(adds) | prior
+    failed = df["reason"].eq(FailureReason.REGISTRATION_FAILED.value) if "reason" in df else False
+    return np.isfinite(adds) | prior | failed
 
 
 def setting_table(

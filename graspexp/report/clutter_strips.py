@@ -1,7 +1,8 @@
 """A picture strip of every failed attempt of the clutter rounds below a directory, drawn from the round
 logs alone (no simulator, no meshes): the scene when the attempt was planned and when it ended, with the
 planned grasp frame (X red, Y green, Z blue). An attempt that found no grasp (the round's last) is drawn
-once, as the planner saw it. Files are named
+once, as the planner saw it, and one that ended before anything was planned (``not_at_rest``) once, when it
+ended. Files are named
 ``<dataset>_<planner>_<mode>_r<round>_a<attempt>_<reason>.png``; ``clutter_failures.md`` lists them
 beside the round log each came from, to open in Foxglove.
 """
@@ -41,6 +42,10 @@ def attempt_times(log: TrialLog) -> dict[int, tuple[float, float]]:
     return {a: (t0, t1) for a, (t0, t1) in times.items()}
 
 
+def _finite(value: object) -> bool:
+    return isinstance(value, int | float) and bool(np.isfinite(value))
+
+
 def _grasp_between(log: TrialLog, t0: float, t1: float) -> np.ndarray | None:
     """(4, 4) world pose of the last grasp logged in [t0, t1], None when none was."""
     poses = [g["pose"] for g in log.grasps if t0 <= g["t_s"] <= t1]
@@ -61,13 +66,17 @@ def draw_round_failures(log: TrialLog, out: Path) -> list[dict]:
     times = attempt_times(log)
     rows = []
     for a in rr.get("attempts", []):
-        if a.get("success") or int(a["attempt"]) not in times:
+        planned = int(a["attempt"]) in times
+        if a.get("success") or not (planned or _finite(a.get("sim_time_s"))):
             continue
-        t0, t1 = times[int(a["attempt"])]
-        grasp = _grasp_between(log, t0, t1)
+        t0, t1 = times[int(a["attempt"])] if planned else (float(a["sim_time_s"]),) * 2
+        grasp = _grasp_between(log, t0, t1) if planned else None
         reason = a.get("reason") or "(none)"
         name = f"{rr['dataset']}_{rr['planner']}_{rr['mode']}_r{int(rr['round']):03d}_a{int(a['attempt'])}_{reason}"
-        instants = {"planned": t0, "ended": t1} if a.get("executed") else {"no grasp found": t0}
+        if not planned:  # ended before anything was planned (a heap not at rest): the scene then
+            instants = {"not planned": t0}
+        else:
+            instants = {"planned": t0, "ended": t1} if a.get("executed") else {"no grasp found": t0}
         title = (
             f"{rr['mode']} · {rr['planner']} · round {int(rr['round'])}, attempt {int(a['attempt'])}: "
             f"{a['target']} · {reason}"
@@ -115,7 +124,7 @@ def write_clutter_strips(root: Path | str, out_dir: Path | str) -> str:
         "# Failed attempts in clutter",
         "",
         "Each strip: left, the scene when the attempt was planned; right, when it ended (an attempt that found "
-        "no grasp, the round's last, is drawn once). Blue: the objects' collision shapes; grey: gripper "
+        "no grasp, the round's last, is drawn once, and one that ended before anything was planned, when it ended). Blue: the objects' collision shapes; grey: gripper "
         "boxes; brown: the support top; red / green / blue lines: the planned grasp frame's X, Y (closing) "
         "and Z (approach).",
         "",

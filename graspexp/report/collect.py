@@ -19,8 +19,8 @@ import pandas as pd
 
 from graspexp.config.differences import result_config
 from graspexp.core.outcome import FailureReason, TrialResult, result_from_dict
-from graspexp.core.run_layout import TRIALS_DIR, hydra_dir, results_tables, trials_dir
-from graspexp.core.userinput import load_user_yaml, read_user_yaml, shown
+from graspexp.core.run_layout import TRIALS_DIR, hydra_dir, results_tables, trial_log_path, trials_dir
+from graspexp.core.userinput import UserInputError, load_user_yaml, read_user_yaml, shown
 from graspexp.record import CorruptLogError, read_result, read_round
 from graspexp.record.reader import read_metadata
 from graspexp.record.writer import PARTIAL_SUFFIX
@@ -130,24 +130,38 @@ def is_round_log(path: Path) -> bool:
 
 
 def _csv_rows(root: Path) -> tuple[list[dict], list[tuple[Path, str]]]:
-    """Rows of every results.csv below ``root`` whose run directory holds no trial log, each checked as
-    strictly as a log's /result (:func:`csv_result`); a table with a bad row is unreadable as a whole."""
+    """Rows of every results.csv below ``root`` that no trial log of its run directory holds (a ``record=false``
+    run's: the runner keeps them beside logged ones of the same config), each checked as strictly as a log's
+    /result (:func:`csv_result`); a table with a bad row is unreadable as a whole (a run with logs: its table
+    is their cache, and only rows without a log are read)."""
     rows, unreadable = [], []
     for table in results_tables(root):
         run_dir = table.parent
-        if trials_dir(run_dir).is_dir() and find_trial_logs(run_dir):
-            continue
+        logged = trials_dir(run_dir).is_dir() and bool(find_trial_logs(run_dir))
         hydra_cfg = hydra_dir(run_dir) / "config.yaml"
         try:
             config = read_user_yaml(hydra_cfg) if hydra_cfg.is_file() else None
             noise = noise_of(config if isinstance(config, dict) else None)
             records = pd.read_csv(table, dtype=str, keep_default_na=False).to_dict("records")
-            results = [csv_result(r, f"{table} row {i + 2}") for i, r in enumerate(records)]
+            results = [
+                csv_result(r, f"{table} row {i + 2}")
+                for i, r in enumerate(records)
+                if not (logged and _has_log(run_dir, r))
+            ]
         except (OSError, UnicodeDecodeError, ValueError, pd.errors.ParserError) as exc:
-            unreadable.append((table, str(exc) if str(table) in str(exc) else f"{table}: {exc}"))
+            if not logged:
+                unreadable.append((table, str(exc) if str(table) in str(exc) else f"{table}: {exc}"))
             continue
         rows += [_row(result, "", noise) for result in results]
     return rows, unreadable
+
+
+def _has_log(run_dir: Path, record: dict[str, str]) -> bool:
+    """Whether results.csv row ``record`` (text values) is a trial whose log ``run_dir`` holds."""
+    try:
+        return trial_log_path(run_dir, record.get("object", ""), int(record.get("trial", ""))).is_file()
+    except (UserInputError, ValueError):
+        return False
 
 
 def csv_result(record: dict[str, str], where: str) -> dict:
@@ -162,7 +176,7 @@ def csv_result(record: dict[str, str], where: str) -> dict:
             continue
         tp = hints[key]
         try:
-            out[key] = _csv_value(text, tp)
+            out[key] = csv_value(text, tp)
         except ValueError:
             raise ValueError(f"{where}: {key}={shown(text)} is not {tp}") from None
     try:
@@ -172,7 +186,10 @@ def csv_result(record: dict[str, str], where: str) -> dict:
     return out
 
 
-def _csv_value(text: str, tp: object) -> object:
+def csv_value(text: str, tp: object) -> object:
+    """``text`` (a value pandas wrote) as type ``tp`` of a result dataclass: ``True``/``False`` only, integers
+    within 64 bits, numbers (empty: NaN), text, ``X | None`` (empty: None), flow-style lists and mappings;
+    ValueError for text that is not one."""
     optional = type(None) in typing.get_args(tp)  # ``X | None``: empty text is None
     if optional and text == "":
         return None
@@ -211,6 +228,10 @@ def collect(root: Path | str) -> Collected:
         if "at_rest" in df:  # logs from before not_at_rest existed planned on the moving object
             moving = df["at_rest"].eq(False) & df["reason"].ne(FailureReason.ERROR.value)
             df.loc[moving, ["success", "reason"]] = [False, FailureReason.NOT_AT_REST.value]
+        if "registration_fitness" in df:  # logs from before registration_failed planned on a fit to nothing
+            unfit = df["registration_fitness"].eq(0.0) & df["reason"].ne(FailureReason.ERROR.value)
+            df.loc[unfit, ["success", "reason"]] = [False, FailureReason.REGISTRATION_FAILED.value]
+            df.loc[unfit, ["pose_trans_err_mm", "pose_rot_err_deg", "pose_adds_mm"]] = math.nan
         dup = df.duplicated(list(TRIAL_KEYS), keep="first")
         if dup.any():
             first = df[~dup].set_index(list(TRIAL_KEYS))["path"]

@@ -27,6 +27,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from graspexp.core.outcome import UNPLANNED  # noqa: E402
 from graspexp.report.collect import NOISE_KEYS, collect  # noqa: E402
 from graspexp.report.stats import success_pct  # noqa: E402
 
@@ -83,7 +84,7 @@ def quality_table(df: pd.DataFrame) -> pd.DataFrame:
     grasps that are force-closure at mu <= FC_MU, median smallest mu, and the simulated success rate of
     the force-closure grasps and of the others (%; NaN where a group is empty)."""
     out = []
-    planned = df[df["reason"] != "no_feasible_grasp"]
+    planned = df[~df["reason"].isin(UNPLANNED)]
     for key, g in planned.groupby([*GROUP_KEYS, "planner"], sort=True):
         fc = g["fc_min_mu"] <= FC_MU + 1e-9
         out.append(

@@ -5,7 +5,8 @@ A page is hand-written text around one generated block between :data:`BEGIN` and
 comments, invisible on the site); :func:`replace_block` swaps the block and leaves the rest alone. The
 block opens with :func:`provenance` (command, commit, machine, wall and CPU time, fingerprint) and the
 machine-readable :func:`stamp` that ``python -m graspexp results --check`` reads back
-(:func:`read_stamp`).
+(:func:`page_stamps`: only the block's stamps count, and a garbled, misplaced or conflicting one is a
+problem, never skipped).
 
 The fingerprint (:func:`outcome_fingerprint`) hashes the outcomes of a small fixed set of trials (every
 result column of :data:`OUTCOME_COLUMNS`, as text, so a float that moves in its last digit counts): a
@@ -142,10 +143,12 @@ def read_stamp(text: str) -> Stamp | None:
 
 def add_stamp(text: str, s: Stamp, where: str) -> str:
     """``text`` with the stamp ``s`` (another CPU class's fingerprint of the same numbers) after the block's
-    stamps, in place of an earlier one of the same class. PageError when the page has no stamp, or when its
-    block was made on that class (regenerate it instead)."""
+    stamps, in place of an earlier one of the same class. PageError when the page's generated block has no
+    stamp, or when its block was made on that class (regenerate it instead)."""
     lines = text.split("\n")
-    at = [i for i, ln in enumerate(lines) if _STAMP.fullmatch(ln.strip())]
+    block = _block_lines(lines)
+    inside = range(block[0] + 1, block[1]) if block else range(0)
+    at = [i for i in inside if _STAMP.fullmatch(lines[i].strip())]
     if not at:
         raise PageError(f"{where}: no stamp of a generated block to add one beside")
     if read_stamp(lines[at[0]]).cpu == s.cpu:
@@ -163,6 +166,79 @@ def add_stamp(text: str, s: Stamp, where: str) -> str:
     return "\n".join(out)
 
 
+_MARK = re.compile(r"<!--\s*graspexp results\b|graspexp results page=", re.IGNORECASE)
+"""What marks a line as one of the block's machine-read lines (:data:`BEGIN`, :data:`END`, a stamp)."""
+
+
+def _block_lines(lines: list[str]) -> tuple[int, int] | None:
+    """(index of the :data:`BEGIN` line, index of the :data:`END` line) of a page's lines, or None when
+    it has not exactly one of each, in that order."""
+    begins = [i for i, ln in enumerate(lines) if ln.strip() == BEGIN]
+    ends = [i for i, ln in enumerate(lines) if ln.strip() == END]
+    if len(begins) != 1 or len(ends) != 1 or ends[0] < begins[0]:
+        return None
+    return begins[0], ends[0]
+
+
+def page_stamps(text: str, page: str, where: str) -> tuple[list[Stamp], list[str]]:
+    """The stamps of page ``page`` in the generated block of ``text`` (the file ``where``), the one the block
+    was made with first, and one line per problem (each naming ``where`` and the line; the stamps are then
+    not to be trusted):
+
+    - the page has no generated block (its :data:`BEGIN` and :data:`END` lines, one each, in order);
+    - a line that looks like a stamp (or a marker) but does not parse: a garbled stamp is never skipped;
+    - a stamp outside the block: only the block's stamps count (a regeneration rewrites the block only);
+    - a stamp of another page inside the block;
+    - two stamps of the page for one CPU class (which one holds cannot be told).
+    """
+    lines = text.split("\n")
+    block = _block_lines(lines)
+    if block is None:
+        n_begin = sum(ln.strip() == BEGIN for ln in lines)
+        n_end = sum(ln.strip() == END for ln in lines)
+        shape = (
+            "no generated block"
+            if n_begin == n_end == 0
+            else f"no single generated block ({n_begin} opening and {n_end} closing marker lines)"
+        )
+        return [], [
+            f"{where}: {shape}: it needs one line {BEGIN!r} and, after it, one line {END!r}; "
+            f"restore them and regenerate the page with python -m graspexp results --pages {page}"
+        ]
+    begin, end = block
+    stamps: list[tuple[int, Stamp]] = []
+    problems = []
+    for i, line in enumerate(lines):
+        shown = line.strip()
+        if i in block or not _MARK.search(line):
+            continue
+        m = _STAMP.fullmatch(shown)
+        if m is None:
+            problems.append(f"{where}:{i + 1}: a garbled stamp line, not read: {shown[:120]!r}")
+            continue
+        s = Stamp(m["page"], m["fp"], m["commit"], m["cpu"] or "")
+        if not begin < i < end:
+            problems.append(
+                f"{where}:{i + 1}: a stamp outside the generated block (lines {begin + 1}-{end + 1}), not "
+                f"trusted: {shown}"
+            )
+        elif s.page != page:
+            problems.append(f"{where}:{i + 1}: a stamp of page {s.page!r} in the block of page {page!r}")
+        else:
+            stamps.append((i, s))
+    by_class: dict[str, list[tuple[int, Stamp]]] = {}
+    for i, s in stamps:
+        by_class.setdefault(s.cpu, []).append((i, s))
+    for cpu, same in by_class.items():
+        if len(same) > 1:
+            at = ", ".join(f"{i + 1} ({s.fingerprint})" for i, s in same)
+            problems.append(
+                f"{where}: {len(same)} stamps of page {page!r} for CPU class {cpu or '(none)'}, lines {at}: "
+                "one class holds one fingerprint; delete the wrong line or regenerate the page"
+            )
+    return [s for _, s in stamps], problems
+
+
 def stamp_for(stamps: list[Stamp], cpu: str) -> Stamp | None:
     """The stamp of ``stamps`` that a machine of CPU class ``cpu`` checks: its own class's, else one without
     a class (made before classes were recorded: checked on any class without a stamp of its own), else
@@ -171,14 +247,15 @@ def stamp_for(stamps: list[Stamp], cpu: str) -> Stamp | None:
 
 
 def replace_block(text: str, block: str, where: str) -> str:
-    """``text`` with its generated block replaced by ``block`` (between :data:`BEGIN` and :data:`END`);
-    ``where`` names the file for the error."""
-    start, end = text.find(BEGIN), text.find(END)
-    if start < 0 or end < start:
+    """``text`` with its generated block replaced by ``block`` (the lines between the :data:`BEGIN` line and
+    the :data:`END` line, one of each); ``where`` names the file for the error."""
+    lines = text.split("\n")
+    at = _block_lines(lines)
+    if at is None:
         raise PageError(
             f"{where} has no generated block: add a line {BEGIN!r} and a line {END!r} where the tables go"
         )
-    return text[: start + len(BEGIN)] + "\n" + block.strip("\n") + "\n" + text[end:]
+    return "\n".join([*lines[: at[0] + 1], block.strip("\n"), *lines[at[1] :]])
 
 
 def duration(seconds: float) -> str:

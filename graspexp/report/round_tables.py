@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from graspexp.core.rounds import AttemptResult, RoundEnd, RoundResult
-from graspexp.core.run_layout import ATTEMPTS_CSV, ROUNDS_CSV, TRIALS_DIR
-from graspexp.record import CorruptLogError, iter_trial_logs, read_round
-from graspexp.report.collect import is_round_log
+from graspexp.core.rounds import RoundEnd, RoundResult
+from graspexp.core.run_layout import ATTEMPTS_CSV, ROUNDS_CSV, TRIALS_DIR, round_log_path
+from graspexp.record import CorruptLogError, iter_trial_logs, read_result, read_round
+from graspexp.report.round_csv import ATTEMPT_LIST_FIELDS, ROUND_LIST_FIELDS, RoundTableError, rounds_from_csv
 from graspexp.report.stats import percentiles, success_pct
 
 
@@ -23,7 +23,7 @@ def rounds_frame(rounds: Iterable[RoundResult]) -> pd.DataFrame:
         d = r.to_dict()
         d.pop("attempts")
         d.update(n_placed=r.n_placed, n_removed=r.n_removed, n_attempts=sum(a.executed for a in r.attempts))
-        for key in ("drawn", "placed", "removed"):
+        for key in ROUND_LIST_FIELDS:
             d[key] = " ".join(d[key])
         rows.append(d)
     return pd.DataFrame(rows)
@@ -36,7 +36,7 @@ def attempts_frame(rounds: Iterable[RoundResult]) -> pd.DataFrame:
     for r in rounds:
         for a in r.attempts:
             row = {"dataset": r.dataset, "mode": r.mode, "planner": r.planner, **a.to_dict()}
-            for key in ("touched_neighbours", "moved_neighbours"):
+            for key in ATTEMPT_LIST_FIELDS:
                 row[key] = " ".join(row[key])
             rows.append(row)
     return pd.DataFrame(rows)
@@ -44,63 +44,110 @@ def attempts_frame(rounds: Iterable[RoundResult]) -> pd.DataFrame:
 
 def read_rounds(run_dir: Path | str) -> list[RoundResult]:
     """The rounds of a run directory, from its round logs (``trials/<mode>/NNN.mcap``), else from its
-    ``rounds.csv`` / ``attempts.csv`` (a ``record=false`` run). A damaged log is skipped."""
-    out = []
+    ``rounds.csv`` / ``attempts.csv`` (a ``record=false`` run; :func:`rounds_from_csv`: RoundTableError for a
+    table that breaks its schema). A damaged log is skipped."""
+    rounds, _ = _logged_rounds(Path(run_dir))
+    if rounds or not (Path(run_dir) / ROUNDS_CSV).is_file():
+        return rounds
+    return rounds_from_csv(run_dir)
+
+
+def _logged_rounds(run_dir: Path) -> tuple[list[RoundResult], list[tuple[Path, str]]]:
+    """The rounds of ``run_dir``'s finished round logs, and (path, reason) for each whose /round message is not
+    a round result. A log that is not a round's, or not finished, or damaged, is left to
+    :func:`graspexp.report.collect.collect`, which names it."""
+    rounds, bad = [], []
     for path in iter_trial_logs(run_dir):
         try:
-            out.append(RoundResult.from_dict(read_round(path)))
-        except (CorruptLogError, ValueError):
+            message = read_round(path)
+        except (CorruptLogError, OSError):
             continue
-    if out or not (Path(run_dir) / ROUNDS_CSV).is_file():
-        return out
-    return _rounds_from_csv(Path(run_dir))
+        try:
+            rounds.append(RoundResult.from_dict(message))
+        except ValueError as exc:
+            bad.append((path, f"{path}: {exc}"))
+    return rounds, bad
+
+
+def _log_kind(path: Path) -> str:
+    """``round`` for a finished round log, ``trial`` for a finished trial log, else ``""``."""
+    for kind, read in (("round", read_round), ("trial", read_result)):
+        try:
+            read(path)
+        except (CorruptLogError, OSError):
+            continue
+        return kind
+    return ""
 
 
 def round_log_dirs(root: Path | str) -> list[Path]:
     """The folders below ``root`` that hold a clutter job's round logs (``trials/<mode.name>/`` of a run
-    directory: a folder of one job's logs holds one kind, so its first finished log tells), sorted."""
+    directory), sorted. A folder holds one job's logs, of one kind: its first log that reads as a round's or a
+    trial's tells (a killed run's damaged or unfinished logs are passed over, so its finished rounds count)."""
     out = []
     for folder in sorted({p.parent for p in Path(root).rglob(f"{TRIALS_DIR}/*/*.mcap")}):
-        first = next(iter(sorted(folder.glob("*.mcap"))), None)
-        if first is not None and is_round_log(first):
+        kinds = (_log_kind(p) for p in sorted(folder.glob("*.mcap")) if p.is_file())
+        if next((k for k in kinds if k), "") == "round":
             out.append(folder)
     return out
 
 
-def find_rounds(root: Path | str) -> list[RoundResult]:
-    """Every round below ``root`` (a run or a sweep directory): the run directories that hold a ``rounds.csv``
-    or round logs (:func:`round_log_dirs`), each read by :func:`read_rounds`."""
-    root = Path(root)
+def _round_runs(root: Path) -> list[Path]:
+    """The run directories below ``root`` that hold a ``rounds.csv`` or round logs, sorted."""
     runs = {p.parent for p in root.rglob(ROUNDS_CSV)}
     runs |= {d.parent.parent for d in round_log_dirs(root)}
-    return [r for run in sorted(runs) for r in read_rounds(run)]
+    return sorted(runs)
 
 
-def _rounds_from_csv(run_dir: Path) -> list[RoundResult]:
-    rounds = pd.read_csv(run_dir / ROUNDS_CSV, keep_default_na=False)
-    attempts = (
-        pd.read_csv(run_dir / ATTEMPTS_CSV, keep_default_na=False)
-        if (run_dir / ATTEMPTS_CSV).is_file()
-        else None
-    )
-    out = []
-    for _, row in rounds.iterrows():
-        mine = [] if attempts is None else attempts[attempts["round"] == row["round"]].to_dict("records")
-        for a in mine:
-            for key in ("dataset", "mode", "planner"):
-                a.pop(key, None)
-            a["reason"] = a["reason"] or None
-            for key in ("touched_neighbours", "moved_neighbours"):
-                a[key] = str(a[key]).split()
-        out.append(
-            RoundResult(
-                dataset=row["dataset"], mode=row["mode"], planner=row["planner"], round=int(row["round"]),
-                seed=int(row["seed"]), drawn=str(row["drawn"]).split(), placed=str(row["placed"]).split(),
-                removed=str(row["removed"]).split(), end=row["end"], attempts=[AttemptResult(**a) for a in mine],
-                error=str(row["error"]),
+def _run_rounds(run_dir: Path) -> tuple[list[RoundResult], list[tuple[Path, str]]]:
+    """Every round of a run directory: its finished round logs, and the rows of its ``rounds.csv`` that no
+    round log holds (a ``record=false`` run's, kept beside logged rounds of the same config by the runner),
+    by round; (path, reason) for a log whose /round is not a round result (:func:`_logged_rounds`). Raises
+    :class:`RoundTableError` for a table that breaks its schema, even beside logs (its rows without a log
+    would be lost silently)."""
+    rounds, bad = _logged_rounds(run_dir)
+    if (run_dir / ROUNDS_CSV).is_file():
+        rounds += [r for r in rounds_from_csv(run_dir) if not _logged(run_dir, r)]
+    return sorted(rounds, key=lambda r: (r.dataset, r.mode, r.planner, r.round)), bad
+
+
+def _logged(run_dir: Path, r: RoundResult) -> bool:
+    """Whether round ``r``'s log file is in ``run_dir`` (even unfinished or damaged: then it is named)."""
+    try:
+        return round_log_path(run_dir, r.mode, r.round).exists()
+    except ValueError:  # a mode name that cannot be a folder: no log of it
+        return False
+
+
+def find_rounds(root: Path | str) -> list[RoundResult]:
+    """Every round below ``root`` (a run or a sweep directory): of each run directory that holds a
+    ``rounds.csv`` or round logs (:func:`round_log_dirs`), its logged rounds and its table's rows without a log
+    (RoundTableError for a table that breaks its schema)."""
+    return [r for run in _round_runs(Path(root)) for r in _run_rounds(run)[0]]
+
+
+def collect_rounds(root: Path | str) -> tuple[list[RoundResult], list[tuple[Path, str]]]:
+    """As :func:`find_rounds`, never raising for what it cannot read: the rounds, and (path, one-line reason) for
+    each table refused whole (:class:`RoundTableError`: none of its rows counts; a run's logged rounds still
+    do), each round log whose /round is not a round result, and each ``attempts.csv`` without a ``rounds.csv``
+    or round logs beside it (damaged logs are :func:`graspexp.report.collect.collect`'s to name)."""
+    root = Path(root)
+    rounds, bad = [], []
+    runs = _round_runs(root)
+    for run in runs:
+        try:
+            found, bad_logs = _run_rounds(run)
+        except RoundTableError as exc:
+            found, bad_logs = _logged_rounds(run)
+            bad.append((exc.path, str(exc)))
+        rounds += found
+        bad += bad_logs
+    for table in sorted(root.rglob(ATTEMPTS_CSV)):
+        if table.parent not in runs:
+            bad.append(
+                (table, f"{table}: no {ROUNDS_CSV} or round log beside it: its attempts are in no table")
             )
-        )  # fmt: skip
-    return out
+    return rounds, bad
 
 
 def clutter_table(rounds: list[RoundResult]) -> pd.DataFrame:
@@ -115,7 +162,7 @@ def clutter_table(rounds: list[RoundResult]) -> pd.DataFrame:
             if len(att)
             else att
         )
-        done = rg[rg["end"] != RoundEnd.ERROR.value]
+        done = rg[~rg["end"].isin([RoundEnd.ERROR.value, RoundEnd.NOTHING_PLACED.value])]  # ran a planner
         executed = ag[ag["executed"]] if len(ag) else ag
         n_ok = int(executed["success"].sum()) if len(executed) else 0
         gsr = success_pct(n_ok, len(executed))

@@ -3,6 +3,7 @@ package versions, the machine, and each trial's object; Hydra's record of an acc
 
 import functools
 import hashlib
+import json
 import platform
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
@@ -123,6 +124,14 @@ def trial_metadata(job_meta: dict[str, str], loaded: LoadedObject, trial: int, s
         "object": loaded.model.name,
         "trial": str(trial),
         "trial_seed": str(seed),
+        **object_metadata(loaded),
+    }
+
+
+def object_metadata(loaded: LoadedObject) -> dict[str, str]:
+    """What an object of a trial was made of (:func:`trial_metadata`), also what the run record keeps of each
+    object (:mod:`graspexp.run.run_record`)."""
+    return {
         "mesh_source": loaded.model.source,
         "mesh_sha256": loaded.model.mesh_sha256,
         **loaded.model.mesh_facts,
@@ -132,6 +141,34 @@ def trial_metadata(job_meta: dict[str, str], loaded: LoadedObject, trial: int, s
         "area_sha256": loaded.model.area_sha256,
         "object_notes": "\n".join(loaded.notes),
     }
+
+
+POOL_KEYS = ("mesh_source", "mesh_sha256", "collision_sha256", "area_sha256")
+"""What a clutter round's log records of each object of its pool (:func:`pool_metadata`)."""
+
+
+def pool_metadata(pool: list[LoadedObject]) -> str:
+    """A clutter job's pool as its round logs record it (metadata ``round_pool``): a JSON list, in the pool's
+    order (a round draws its objects by position), of each object's name and :data:`POOL_KEYS`; what resume
+    compares before reusing a round and ``replay --resim`` before re-simulating one."""
+    entries = [{"name": o.model.name, **{k: object_metadata(o)[k] for k in POOL_KEYS}} for o in pool]
+    return json.dumps(entries, separators=(",", ":"))
+
+
+def recorded_pool(meta: dict) -> list[dict[str, str]] | None:
+    """The pool a round log's metadata (or the run record) records (:func:`pool_metadata`); None when it
+    records none (a round logged before graspexp recorded pools); ValueError for one that is not such a
+    list."""
+    text = meta.get("round_pool")
+    if text is None:
+        return None
+    entries = json.loads(text) if isinstance(text, str) else text
+    if not isinstance(entries, list) or not all(
+        isinstance(e, dict) and isinstance(e.get("name"), str) and all(isinstance(v, str) for v in e.values())
+        for e in entries
+    ):
+        raise ValueError("its recorded round_pool is not a list of objects with their mesh hashes")
+    return entries
 
 
 def unusable_trial_metadata(

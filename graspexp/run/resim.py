@@ -9,6 +9,7 @@ from graspexp.config.errors import ConfigError
 from graspexp.config.registry import job_config_from_yaml
 from graspexp.datasets.catalog import DATA_ENV
 from graspexp.run.objects import load_sim_object, round_context, trial_context
+from graspexp.run.provenance import recorded_pool
 from graspexp.sim.rounds import run_round
 from graspexp.sim.trial import NullRecorder, plain_config, run_trial
 
@@ -109,7 +110,7 @@ def _resimulate_round(log, cfg, plain) -> tuple[bool, str]:
     ctx = round_context(plain, loaded, int(meta["trial"]), int(meta["trial_seed"]), capture)
     result = run_round(ctx)
     logged = log.round_result
-    problems = []
+    problems = _pool_mesh_differences(meta, loaded)
     if (logged["end"], logged["removed"]) != (result.end, result.removed):
         problems.append(
             f"round differs: logged end={logged['end']} removed={logged['removed']}, re-simulated "
@@ -128,3 +129,22 @@ def _resimulate_round(log, cfg, plain) -> tuple[bool, str]:
         True,
         f"round ({result.end}, {len(result.removed)}/{len(result.placed)} removed, {len(ours)} attempts) and {n} logged poses reproduced",
     )
+
+
+def _pool_mesh_differences(meta: dict, loaded: list) -> list[str]:
+    """One "mesh differs" line per drawn object whose mesh the round log's pool (``round_pool``) records with
+    another SHA-256 than this data root gives (a round logged before pools were recorded: none)."""
+    try:
+        pool = {e["name"]: e for e in recorded_pool(meta) or []}
+    except (ValueError, RecursionError) as exc:
+        raise ConfigError(f"the round log's metadata: {exc}") from None
+    problems = []
+    for o in {o.model.name: o for o in loaded}.values():
+        recorded = pool.get(o.model.name, {}).get("mesh_sha256")
+        if recorded and recorded != o.model.mesh_sha256:
+            was = pool[o.model.name].get("mesh_source") or "a procedural mesh"
+            problems.append(
+                f"mesh differs: {o.model.name}: the log was made on {was} (sha256 {recorded[:12]}), this data "
+                f"root gives {o.model.source or 'a procedural mesh'} (sha256 {o.model.mesh_sha256[:12]})"
+            )
+    return problems

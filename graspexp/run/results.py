@@ -45,13 +45,14 @@ import pandas as pd
 
 from graspexp.core.run_layout import ATTEMPTS_CSV, results_csv
 from graspexp.report.pages import (
+    PageError,
     Provenance,
     Stamp,
     add_stamp,
     duration,
     outcome_fingerprint,
+    page_stamps,
     provenance,
-    read_stamps,
     replace_block,
     stamp_for,
 )
@@ -301,13 +302,66 @@ def run_sweep(sweep: Sweep, out: Path, overrides: Sequence[str], label: str, com
     return result
 
 
+def _writable(path: Path) -> bool:
+    """Whether this process may create, replace and remove files in the folder ``path`` (or write the file
+    ``path``): :func:`os.access` (False on a read-only file system, for root too)."""
+    return os.access(path, os.W_OK)
+
+
+def _nearest(path: Path) -> Path:
+    """``path`` or its nearest folder above that exists."""
+    path = path.absolute()
+    while not path.exists() and path.parent != path:
+        path = path.parent
+    return path
+
+
+def unwritable(pages: Sequence[Page], root: Path, out: Path) -> list[str]:
+    """One line per reason :func:`regenerate` could not write its output: a page file under ``root`` that
+    is missing, not a regular file, without its generated block or not writable; a page's folder where its
+    figures folder cannot be made; ``out`` (the runs) not writable. [] when all can be written: checked
+    before any sweep runs, so that nothing fails after hours of them."""
+    problems = []
+    for page in pages:
+        path = root / page.path
+        if not path.is_file():
+            what = "is not a regular file" if path.exists() else "does not exist"
+            problems.append(f"page {page.name}: {path} {what} (--root names the repository root)")
+            continue
+        try:
+            replace_block(path.read_text(), "", str(path))
+        except PageError as exc:
+            problems.append(str(exc))
+            continue
+        except (OSError, UnicodeDecodeError) as exc:
+            problems.append(
+                f"page {page.name}: {path} cannot be read ({getattr(exc, 'strerror', None) or exc})"
+            )
+            continue
+        for target in (path, path.parent):
+            if not _writable(target):
+                problems.append(f"page {page.name}: {target} is not writable (a read-only root?)")
+                break
+    base = _nearest(out)
+    if not base.is_dir() or not _writable(base):
+        problems.append(
+            f"the run folder {out} cannot be made: {base} is not a writable folder (choose --out)"
+        )
+    return problems
+
+
 def regenerate(
     pages: Sequence[Page], root: Path, out: Path, overrides: Sequence[str], command: str, n_jobs: int
 ) -> list[str]:
     """Run the sweeps of ``pages`` (each once, resumable) into ``out/runs``, their fingerprints, and write
     each page's generated block into its file under ``root``; returns one line per sweep that failed (its
-    pages are then left as they were). A page whose planners cannot run here is skipped (:func:`available`)."""
+    pages are then left as they were). A page whose planners cannot run here is skipped (:func:`available`).
+    :class:`ResultsError` (one line), before any sweep runs, when a page file or ``out`` cannot be written
+    (:func:`unwritable`)."""
     pages = available(pages)
+    cannot = unwritable(pages, root, out)
+    if cannot:
+        raise ResultsError(f"nothing run: {'; '.join(cannot)}")
     commit, date = commit_of(root)
     machine = describe_machine()
     sweeps = list(dict.fromkeys(s for page in pages for s in page.sweeps))
@@ -352,7 +406,11 @@ def regenerate(
         work.mkdir(parents=True, exist_ok=True)
         shutil.rmtree(assets, ignore_errors=True)  # every file in it is drawn again: none outlives its page
         body = page.render(PageInput({s: out / "runs" / s.name for s in page.sweeps}, assets, work))
-        path.write_text(replace_block(path.read_text(), head + "\n" + body, str(path)))
+        try:  # checked before the sweeps; changed since
+            path.write_text(replace_block(path.read_text(), head + "\n" + body, str(path)))
+        except (OSError, PageError) as exc:
+            problems.append(f"page {page.name} ({path}) not written: {getattr(exc, 'strerror', None) or exc}")
+            continue
         print(f"graspexp results: wrote {path}", file=sys.stderr)
     ran = [t for t in times.values() if not t.skipped]
     cpu_all = "n/a" if any(t.cpu_s is None for t in ran) else duration(sum(t.cpu_s or 0.0 for t in ran))
@@ -376,29 +434,45 @@ def _fingerprint_trials(jobs: Sequence[Sequence[str]]) -> int:
     return n
 
 
-def _page_stamps(page: Page, root: Path) -> list[Stamp]:
-    """The stamps of ``page`` in its file under ``root`` ([] when it has none or no file)."""
+def _page_stamps(page: Page, root: Path) -> tuple[list[Stamp], list[str]]:
+    """The stamps of ``page`` in the generated block of its file under ``root`` and one line per problem
+    of the file (:func:`graspexp.report.pages.page_stamps`; no file, no block: a problem)."""
     path = root / page.path
-    return [s for s in read_stamps(path.read_text()) if s.page == page.name] if path.is_file() else []
+    try:
+        text = path.read_text()
+    except FileNotFoundError:
+        return [], [f"{page.path}: no such file under {root}: {_regenerate(page)}"]
+    except (OSError, UnicodeDecodeError) as exc:
+        return [], [f"{page.path}: cannot be read ({getattr(exc, 'strerror', None) or exc})"]
+    return page_stamps(text, page.name, page.path)
+
+
+def _regenerate(page: Page) -> str:
+    return f"run python -m graspexp results --pages {page.name}"
 
 
 def _unstamped(page: Page) -> str:
-    return f"{page.path}: no fingerprint of page {page.name!r}: run python -m graspexp results"
+    return f"{page.path}: no fingerprint of page {page.name!r} in its generated block: {_regenerate(page)}"
 
 
 def check(pages: Sequence[Page], root: Path, n_jobs: int) -> list[str]:
     """One line per page of ``pages`` whose fingerprint for this machine's CPU class (:func:`.pages.stamp_for`)
-    the current code does not reproduce (or that records none); [] when every page is current. A page whose
-    planners cannot run here is skipped (:func:`available`), and so, with a line saying so, is a page that
-    records fingerprints of other CPU classes only (its last digits are not this machine's to check)."""
+    the current code does not reproduce (or that records none); [] when every page is current. Only the
+    stamps inside a page's generated block count; a page without its block, or with a garbled stamp line, a
+    stamp outside the block or two stamps for one class is a problem (one line each, naming the page and
+    the line) and is not fingerprinted. A page whose planners cannot run here is skipped
+    (:func:`available`), and so, with a line saying so, is a page that records fingerprints of other CPU
+    classes only (its last digits are not this machine's to check)."""
     pages = available(pages)
     cpu = cpu_class()
     recorded = {}
     problems = []
     for page in pages:
-        stamps = _page_stamps(page, root)
+        stamps, wrong = _page_stamps(page, root)
         mine = stamp_for(stamps, cpu)
-        if not stamps:
+        if wrong:  # a page whose stamps cannot be trusted is not checked: it is not current
+            problems += wrong
+        elif not stamps:
             problems.append(_unstamped(page))
         elif mine is None:
             classes = ", ".join(sorted({s.cpu for s in stamps}))
@@ -431,17 +505,21 @@ def check(pages: Sequence[Page], root: Path, n_jobs: int) -> list[str]:
 def stamp_cpu(pages: Sequence[Page], root: Path, n_jobs: int) -> list[str]:
     """Record this machine's CPU class's fingerprint beside the stamps of each page of ``pages`` that has
     none of this class, from the current code; [] or one line per page left alone (never generated; made on
-    this class: regenerate it). Run it at a commit whose pages are current on the class they were made on
+    this class: regenerate it; a problem of its stamps, as :func:`check` reports them; not writable). Run it at a commit whose pages are current on the class they were made on
     (``results --check`` there): the new stamp then says what the same code gives on this class."""
     pages = available(pages)
     cpu = cpu_class()
     problems, todo = [], []
     for page in pages:
-        stamps = _page_stamps(page, root)
-        if not stamps:
+        stamps, wrong = _page_stamps(page, root)
+        if wrong:
+            problems += wrong
+        elif not stamps:
             problems.append(_unstamped(page))
         elif stamps[0].cpu == cpu:
             print(f"graspexp results: {page.path}: made on {cpu}, nothing to add", file=sys.stderr)
+        elif not _writable(root / page.path):
+            problems.append(f"{page.path}: not writable under {root}: no fingerprint taken for it")
         else:
             todo.append(page)
     commit = commit_of(root)[0]

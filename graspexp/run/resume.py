@@ -1,12 +1,15 @@
 """Resuming a job into a directory that already holds trials: the checks that refuse a directory of
-another config or another mesh, the lock, the finished trials read back, and the files moved aside.
+another config, another mesh or another clutter pool, the lock, the finished trials read back, and the files
+moved aside.
 
 A re-run reuses the trials whose log is complete, provided every log's recorded config equals this run's
 on every key that affects a result (:mod:`graspexp.config.differences`); trials that ended in ``error``,
 damaged logs and files that are not graspexp trial logs are moved into ``trials/.quarantine/`` (never
-deleted) and redone."""
+deleted) and redone. The rows of the tables that no log backs (``record=false`` runs) are checked the same
+way against the run record (:mod:`graspexp.run.run_record`), and kept: one rule, logged or not."""
 
 import datetime
+import json
 import logging
 import os
 from collections.abc import Callable
@@ -18,14 +21,17 @@ from omegaconf import DictConfig
 from graspexp.config.differences import config_differences
 from graspexp.core.outcome import FailureReason, TrialResult, result_from_dict
 from graspexp.core.run_layout import (
+    ATTEMPTS_CSV,
     HYDRA_FILES,
     LOCK_NAME,
+    ROUNDS_CSV,
     LinkedRunPathError,
     check_not_linked,
     hydra_dir,
     quarantine_path,
     real_folder,
     results_csv,
+    run_record_path,
     summary_md,
     trials_dir,
 )
@@ -33,6 +39,8 @@ from graspexp.record import CorruptLogError, iter_trial_logs, read_result
 from graspexp.record.reader import read_metadata
 from graspexp.run.locks import DirectoryLock, RunError
 from graspexp.run.objects import LoadedObject
+from graspexp.run.provenance import pool_metadata, recorded_pool
+from graspexp.run.run_record import read_run_record, table_results, table_rounds
 
 log = logging.getLogger(__name__)
 T = TypeVar("T")
@@ -66,15 +74,72 @@ def check_resumable(cfg: DictConfig, run_dir: Path, move_foreign: bool = True) -
             foreign.append((path, f"{path}: unreadable recorded config ({type(exc).__name__})"))
             continue
         if diff:
-            keys = sorted(diff, key=lambda k: ("." in k and not k.endswith(".name"), k))  # choices first
-            shown = "; ".join(f"{k}: {diff[k][0]!r} in the log, {diff[k][1]!r} now" for k in keys[:4])
-            raise RunError(
-                f"{run_dir} holds trial logs made with a different config; differing keys: {', '.join(keys)} "
-                f"({path.relative_to(run_dir)}: {shown}); resume only reuses logs of the same config: "
-                f"choose another output directory (hydra.run.dir / hydra.sweep.dir) or delete {trials_dir(run_dir)}"
-            )
+            raise RunError(_config_refusal(run_dir, path, diff, "trial logs", "the log"))
+    _check_tables_record(cfg, run_dir)
     for path, why in foreign if move_foreign else ():
         quarantine(path, run_dir, why)
+
+
+def _config_refusal(
+    run_dir: Path, path: Path, diff: dict[str, tuple[object, object]], what: str, where: str
+) -> str:
+    keys = sorted(diff, key=lambda k: ("." in k and not k.endswith(".name"), k))  # choices first
+    shown = "; ".join(f"{k}: {diff[k][0]!r} in {where}, {diff[k][1]!r} now" for k in keys[:4])
+    return (
+        f"{run_dir} holds {what} made with a different config; differing keys: {', '.join(keys)} "
+        f"({path.relative_to(run_dir)}: {shown}); resume only reuses {what} of the same config: {afresh(run_dir)}"
+    )
+
+
+def afresh(run_dir: Path) -> str:
+    """What a refused run can do: another output directory, or delete what ``run_dir`` holds of earlier runs
+    (its logs, tables and their record: :mod:`graspexp.run.run_record`)."""
+    held = [
+        trials_dir(run_dir),
+        results_csv(run_dir),
+        *(Path(run_dir) / n for n in (ROUNDS_CSV, ATTEMPTS_CSV)),
+    ]
+    held = [p for p in (*held, run_record_path(run_dir)) if p.exists()] or [trials_dir(run_dir)]
+    return "choose another output directory (hydra.run.dir / hydra.sweep.dir) or delete " + ", ".join(
+        map(str, held)
+    )
+
+
+def _check_tables_record(cfg: DictConfig, run_dir: Path) -> None:
+    """Raise RunError if the tables hold rows that no log backs (those of ``record=false`` runs) and the run
+    record (:mod:`graspexp.run.run_record`) that says what made them has a different config, or there is no
+    record (tables written before graspexp kept it: rows of an unknown config, neither kept nor
+    overwritten). Such rows are kept, so they are checked readable here. A record with no such row to
+    speak for is not compared (a run killed before its tables were written)."""
+    record = read_run_record(run_dir)
+    path = run_record_path(run_dir)
+    for table, rows in ((results_csv(run_dir), table_results), (Path(run_dir) / ROUNDS_CSV, table_rounds)):
+        try:
+            check_not_linked(table)
+        except LinkedRunPathError as exc:
+            raise RunError(str(exc)) from None
+        unbacked = rows(run_dir)
+        if not unbacked:
+            continue
+        if record is None:
+            shown = ", ".join(_row_name(k) for k in list(unbacked)[:4])
+            raise RunError(
+                f"{table} holds {len(unbacked)} rows that no log backs ({shown}{', ...' if len(unbacked) > 4 else ''}) "
+                f"and no {path.name} says what config made them (written before graspexp kept it); resume "
+                f"never overwrites nor mixes rows of an unknown config: {afresh(run_dir)}"
+            )
+        try:
+            diff = config_differences(record["config_yaml"], cfg)
+        except Exception as exc:  # a recorded config that is not YAML of a job config
+            raise RunError(
+                f"{path} is not a graspexp run record (its config: {type(exc).__name__}); {afresh(run_dir)}"
+            ) from None
+        if diff:
+            raise RunError(_config_refusal(run_dir, path, diff, "results", "its record"))
+
+
+def _row_name(key: tuple[str, int] | int) -> str:
+    return f"round {key}" if isinstance(key, int) else f"{key[0]} trial {key[1]}"
 
 
 def check_same_meshes(run_dir: Path, objects: dict[str, LoadedObject]) -> None:
@@ -82,12 +147,16 @@ def check_same_meshes(run_dir: Path, objects: dict[str, LoadedObject]) -> None:
     loads (another data root, a re-download, a rescaled file), with another collision shape (a cache entry
     rewritten by someone else) or another grasping area (an edited area spec): resume never mixes trials of
     two. Values a log does not record (written before graspexp recorded them) and unreadable logs are not
-    compared."""
-    for path in iter_trial_logs(run_dir):
-        try:
-            meta = read_metadata(path) or {}
-        except CorruptLogError:
-            continue
+    compared. The run record's objects (:mod:`graspexp.run.run_record`) that have rows no log backs are
+    compared as logs are."""
+    record = read_run_record(run_dir) or {}
+    rows = {name for name, _ in table_results(run_dir)}  # objects with rows the record speaks for
+    recorded = [
+        (run_record_path(run_dir), {**m, "object": n})
+        for n, m in record.get("objects", {}).items()
+        if n in rows
+    ]
+    for path, meta in (*_log_metadata(run_dir), *recorded):
         loaded = objects.get(meta.get("object", ""))
         if loaded is None:
             continue
@@ -98,8 +167,7 @@ def check_same_meshes(run_dir: Path, objects: dict[str, LoadedObject]) -> None:
                 f"{run_dir} holds trials of {model.name} made on another mesh ({path.relative_to(run_dir)}: "
                 f"{meta.get('mesh_source') or 'procedural'}, sha256 {logged[:12]}{_facts(meta)}; now "
                 f"{model.source or 'procedural'}, sha256 {model.mesh_sha256[:12]}{_facts(model.mesh_facts)}); "
-                f"resume only reuses trials of the same mesh: choose another output directory or delete "
-                f"{trials_dir(run_dir)}"
+                f"resume only reuses trials of the same mesh: {afresh(run_dir)}"
             )
         for key, now, what in (
             ("collision_sha256", loaded.hulls.sha256, "collision shape (a changed cache entry?)"),
@@ -109,8 +177,85 @@ def check_same_meshes(run_dir: Path, objects: dict[str, LoadedObject]) -> None:
                 raise RunError(
                     f"{run_dir} holds trials of {model.name} made with another {what} "
                     f"({path.relative_to(run_dir)}: {key} {meta[key][:12]}, now {now[:12]}); resume only "
-                    f"reuses trials of the same one: choose another output directory or delete {trials_dir(run_dir)}"
+                    f"reuses trials of the same one: {afresh(run_dir)}"
                 )
+
+
+def _log_metadata(run_dir: Path) -> list[tuple[Path, dict[str, str]]]:
+    """(path, metadata) of every readable trial or round log of ``run_dir``."""
+    out = []
+    for path in iter_trial_logs(run_dir):
+        try:
+            out.append((path, read_metadata(path) or {}))
+        except CorruptLogError:
+            continue
+    return out
+
+
+def check_same_pool(
+    run_dir: Path, mode_name: str, pool: list[LoadedObject], unusable: dict[str, str]
+) -> None:
+    """Raise RunError if a round log of ``run_dir`` (or its run record) was drawn from another pool than
+    ``pool`` (other objects, or the same in another order: a round draws by position) or made on another
+    mesh, collision shape or grasping area of one of its objects; ``unusable``: {name: why} of the objects
+    left out of the pool, named when the pool lost one. A round logged before graspexp recorded pools is
+    compared by the objects it drew."""
+    now = json.loads(pool_metadata(pool))
+    record = read_run_record(run_dir) or {}
+    sources = [(p, m) for p, m in _log_metadata(run_dir) if "round_pool" in m or "round_objects" in m]
+    if "round_pool" in record and table_rounds(run_dir):  # rounds without a log: the record speaks for them
+        sources.append((run_record_path(run_dir), record))
+    for path, meta in sources:
+        try:
+            logged = recorded_pool(meta)
+        except (ValueError, RecursionError) as exc:
+            raise RunError(f"{path}: {exc}; {afresh(run_dir)}") from None
+        why = _pool_difference(str(path.relative_to(run_dir)), logged, meta, now, unusable)
+        if why:
+            raise RunError(
+                f"{run_dir} holds rounds of {mode_name} {why}; resume only "
+                f"reuses rounds of the same pool and meshes: {afresh(run_dir)}"
+            )
+
+
+def _pool_difference(
+    where: str,
+    logged: list[dict[str, str]] | None,
+    meta: dict,
+    now: list[dict[str, str]],
+    unusable: dict[str, str],
+) -> str:
+    """How the pool of the round log at ``where`` (``logged``; None: the objects it drew,
+    ``meta['round_objects']``) differs from ``now`` ("" when it does not)."""
+    names = [e["name"] for e in now]
+    lost = "".join(
+        f"; {n} cannot be used now: {unusable[n]}" for n in (e["name"] for e in logged or []) if n in unusable
+    )
+    if logged is None:
+        drawn = str(meta.get("round_objects", "")).split()
+        strangers = [n for n in dict.fromkeys(drawn) if n not in names]
+        if not strangers:
+            return ""
+        lost = "".join(f"; {n} cannot be used now: {unusable[n]}" for n in strangers if n in unusable)
+        return f"drawn from another pool ({where} drew {', '.join(strangers)}; the pool now: {', '.join(names)}{lost})"
+    old = [e["name"] for e in logged]
+    if old != names:
+        only_log = [n for n in old if n not in names]
+        only_now = [n for n in names if n not in old]
+        parts = [f"only earlier: {', '.join(only_log)}"] * bool(only_log) + [
+            f"only now: {', '.join(only_now)}"
+        ] * bool(only_now) or ["the same objects in another order: a round draws them by position"]
+        return f"drawn from another pool ({where}: {', '.join(old)}; now {', '.join(names)}: {'; '.join(parts)}{lost})"
+    for was, is_ in zip(logged, now, strict=True):
+        if was.get("mesh_sha256") and was["mesh_sha256"] != is_["mesh_sha256"]:
+            return (
+                f"made on another mesh of {is_['name']} ({where}: {was.get('mesh_source') or 'procedural'}, sha256 "
+                f"{was['mesh_sha256'][:12]}; now {is_['mesh_source'] or 'procedural'}, sha256 {is_['mesh_sha256'][:12]})"
+            )
+        for key, what in (("collision_sha256", "collision shape"), ("area_sha256", "grasping area")):
+            if was.get(key) and is_[key] and was[key] != is_[key]:
+                return f"made with another {what} of {is_['name']} ({where}: {key} {was[key][:12]}, now {is_[key][:12]})"
+    return ""
 
 
 def check_run_files(run_dir: Path) -> None:
@@ -118,7 +263,13 @@ def check_run_files(run_dir: Path) -> None:
     first trial; every write checks again): nothing is written through a link planted in a shared
     directory."""
     try:
-        for path in (trials_dir(run_dir), results_csv(run_dir), summary_md(run_dir), hydra_dir(run_dir)):
+        tables = (
+            results_csv(run_dir),
+            Path(run_dir) / ROUNDS_CSV,
+            Path(run_dir) / ATTEMPTS_CSV,
+            run_record_path(run_dir),
+        )
+        for path in (trials_dir(run_dir), *tables, summary_md(run_dir), hydra_dir(run_dir)):
             check_not_linked(path)
         if hydra_dir(run_dir).is_dir():
             for name in HYDRA_FILES:
@@ -166,6 +317,8 @@ def finished_result(path: Path, run_dir: Path, object_name: str, trial: int) -> 
             return f"it ended in an error ({result.error})"
         if not result.at_rest and result.reason != FailureReason.NOT_AT_REST.value:
             return "it planned on a moving object (before not_at_rest)"
+        if result.registration_fitness == 0.0 and result.reason != FailureReason.REGISTRATION_FAILED.value:
+            return "it planned on a pose registered from nothing (fitness 0, before registration_failed)"
         return ""
 
     return finished_log(path, run_dir, "trial", lambda p: result_from_dict(read_result(p)), redo)

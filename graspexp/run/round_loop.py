@@ -34,8 +34,9 @@ from graspexp.report.round_tables import (
 )
 from graspexp.run.locks import RunError
 from graspexp.run.objects import LoadedObject, round_context
-from graspexp.run.provenance import job_metadata
+from graspexp.run.provenance import job_metadata, pool_metadata
 from graspexp.run.resume import finished_log
+from graspexp.run.run_record import table_rounds
 from graspexp.run.trial_loop import write_failure
 from graspexp.sim.rounds import run_round
 from graspexp.sim.trial import plain_config
@@ -56,10 +57,9 @@ def run_rounds(
     """Every round of the job (``trials`` of them); finished rounds found in ``run_dir`` are read back. The pool
     is ``objects`` less the unusable ones; an exception inside a round is that round's ``error`` end."""
     plain = plain_config(cfg)
+    pool = clutter_pool(objects, models)
     job_meta = job_metadata(cfg)
-    pool = [name for name in objects if name in models]
-    if not pool:
-        raise RunError(f"no object of the pool {objects} can be used (summary.md says why): nothing to place")
+    pool_meta = pool_metadata([models[n] for n in pool])
     results = []
     for r in range(cfg.trials):
         seed = round_seed(plain, r)
@@ -71,7 +71,9 @@ def run_rounds(
             raise RunError(str(exc)) from None
         result = finished_round(path, run_dir, r)
         if result is None:
-            result = _run_one(cfg, plain, job_meta, path, r, seed, [models[n] for n in drawn])
+            meta = {**job_meta, "object": cfg.mode.name, "trial": str(r), "trial_seed": str(seed),
+                    "round_objects": " ".join(drawn), "round_pool": pool_meta}  # fmt: skip
+            result = _run_one(cfg, plain, meta, path, r, seed, [models[n] for n in drawn])
         results.append(result)
         if bar is not None:
             bar.set_postfix_str(f"round {r}: {result.end}, {result.n_removed}/{result.n_placed}")
@@ -79,9 +81,21 @@ def run_rounds(
     return results
 
 
-def _run_one(cfg, plain, job_meta, path: Path, r: int, seed: int, loaded: list[LoadedObject]) -> RoundResult:
-    meta = {**job_meta, "object": cfg.mode.name, "trial": str(r), "trial_seed": str(seed),
-            "round_objects": " ".join(o.model.name for o in loaded)}  # fmt: skip
+def clutter_pool(objects: list[str], models: dict[str, LoadedObject]) -> list[str]:
+    """The pool the rounds draw from: ``objects`` less the unusable ones (not in ``models``), in their order;
+    RunError when none is left."""
+    pool = [name for name in objects if name in models]
+    if not pool:
+        raise RunError(f"no object of the pool {objects} can be used (summary.md says why): nothing to place")
+    return pool
+
+
+def _run_one(
+    cfg, plain, meta: dict[str, str], path: Path, r: int, seed: int, loaded: list[LoadedObject]
+) -> RoundResult:
+    """Round ``r`` run and logged with metadata ``meta``: the job's, the round's index and seed, the objects it
+    drew (``round_objects``) and the pool with its meshes (``round_pool``: what resume and ``replay --resim``
+    compare)."""
     bodies = round_bodies(len(loaded))
     try:
         with trial_recorder(path if cfg.record else None, meta, plain, bodies) as rec:
@@ -125,13 +139,14 @@ def finished_round(path: Path, run_dir: Path, r: int) -> RoundResult | None:
     return finished_log(path, run_dir, "round", lambda p: RoundResult.from_dict(read_round(p)), redo)
 
 
-def write_round_summary(run_dir: Path, results: list[RoundResult]) -> str:
-    """Write ``rounds.csv``, ``attempts.csv`` and ``summary.md`` for ``results`` and every other finished round
-    log in ``run_dir``; the summary's text."""
-    done = {r.round for r in results}
-    every = sorted(
-        [*results, *(r for r in read_rounds(run_dir) if r.round not in done)], key=lambda r: r.round
-    )
+def write_round_summary(run_dir: Path, results: list[RoundResult]) -> tuple[list[RoundResult], str]:
+    """Write ``rounds.csv``, ``attempts.csv`` and ``summary.md`` for ``results`` and every other round the
+    directory holds: its finished round logs (:func:`graspexp.report.round_tables.read_rounds`), then the rows
+    of its tables no log holds (:func:`graspexp.run.run_record.table_rounds`: those of ``record=false`` runs of
+    the same config, resume refuses another); (every round, by index; the summary's text)."""
+    held = {r.round: r for r in read_rounds(run_dir)}
+    held = {**table_rounds(run_dir), **held, **{r.round: r for r in results}}
+    every = [held[k] for k in sorted(held)]
     text = clutter_markdown(every)
     files = (
         (Path(run_dir) / ROUNDS_CSV, rounds_frame(every).to_csv(index=False).encode()),
@@ -143,7 +158,7 @@ def write_round_summary(run_dir: Path, results: list[RoundResult]) -> str:
             write_atomic(check_not_linked(path), lambda fh, data=data: fh.write(data))
         except OSError as exc:
             raise RunError(f"cannot write {path}: {exc.strerror or exc}") from None
-    return text
+    return every, text
 
 
 def round_objective(results: list[RoundResult]) -> float:
@@ -154,13 +169,19 @@ def round_objective(results: list[RoundResult]) -> float:
 
 
 def timed_rounds(cfg: DictConfig, run_dir: Path, objects, models, wall0: float, cpu0: float) -> float:
-    """Run the rounds, write the tables, print the summary; the job's objective."""
+    """Run the rounds, write the tables, print the summary; the job's objective (over every round the
+    directory holds, as a single-object job's is over every trial)."""
     with tqdm(total=cfg.trials, desc=f"{cfg.mode.name}/{cfg.dataset.name}", disable=not cfg.progress) as bar:
         results = run_rounds(cfg, run_dir, objects, models, bar)
-    text = write_round_summary(run_dir, results)
+    every, text = write_round_summary(run_dir, results)
     print(
-        f"\n{cfg.mode.name} / {cfg.dataset.name} / planner {cfg.planner.name}: {run_dir} ({len(results)} rounds, "
+        f"\n{cfg.mode.name} / {cfg.dataset.name} / planner {cfg.planner.name}: {run_dir} ({len(every)} rounds, "
         f"{time.perf_counter() - wall0:.1f} s wall, {time.process_time() - cpu0:.1f} s CPU)"
     )
     print(text)
-    return round_objective(results)
+    if results and all(r.end == RoundEnd.ERROR.value for r in results):  # as a job none of whose trials ran
+        first = results[0].error.splitlines()[0] if results[0].error else "no message"
+        raise RunError(
+            f"no round ran: every one of the {len(results)} rounds ended in an error (first: {first})"
+        )
+    return round_objective(every)

@@ -4,12 +4,14 @@ The run directory (Hydra's output dir) is laid out as :mod:`graspexp.core.run_la
 into the same directory resumes (:mod:`graspexp.run.resume`): trials whose log is complete are read back,
 not re-run, provided every log's recorded config equals this run's on every key that affects a result;
 otherwise the job stops with :class:`graspexp.run.locks.RunError`. One job at a time writes into a directory (a file lock).
-With ``record=false`` no log is written (faster, but nothing to replay and nothing to resume from).
+With ``record=false`` no log is written (faster, but nothing to replay); its rows are kept by later runs of
+the same config under the same rule, through the run record (:mod:`graspexp.run.run_record`).
 
 The job's steps live in modules of one concern each: provenance (what each log records), resume, objects
 (loading, a trial's context), trial_loop (one object's trials) and summary (results.csv, summary.md).
 """
 
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -21,12 +23,22 @@ from tqdm import tqdm
 from graspexp.config.mode import is_clutter
 from graspexp.core.outcome import TrialResult
 from graspexp.datasets import select_objects
+from graspexp.record.live import live_channels
+from graspexp.record.log_size import log_size_warning
 from graspexp.run.job_config import make_ready
 from graspexp.run.objects import LoadedObject, load_models
 from graspexp.run.prepare import prepare_shapes
 from graspexp.run.provenance import write_hydra_record
-from graspexp.run.resume import check_resumable, check_run_files, check_same_meshes, job_lock, kept_results
-from graspexp.run.round_loop import timed_rounds
+from graspexp.run.resume import (
+    check_resumable,
+    check_run_files,
+    check_same_meshes,
+    check_same_pool,
+    job_lock,
+    kept_results,
+)
+from graspexp.run.round_loop import clutter_pool, timed_rounds
+from graspexp.run.run_record import table_results, write_run_record
 from graspexp.run.summary import objective_value, write_summary
 from graspexp.run.trial_loop import run_object_trials
 
@@ -55,6 +67,10 @@ def _run(cfg: DictConfig, run_dir: Path, on_accepted: Callable[[DictConfig, Path
     objects' loading, then under the lock the checks again and the trials: a refused run leaves
     ``run_dir`` as it found it."""
     wall0, cpu0 = time.perf_counter(), time.process_time()
+    if cfg.live:  # a taken port refuses the run before anything is written (LiveViewError)
+        live_channels(int(cfg.live_port))
+    if warning := log_size_warning(cfg):
+        print(f"graspexp: warning: {warning}", file=sys.stderr)
     objects = select_objects(cfg.dataset, cfg.objects)
     check_resumable(cfg, run_dir, move_foreign=False)
     prepare_shapes(cfg.dataset, cfg.sim, objects, cfg.progress)
@@ -62,7 +78,12 @@ def _run(cfg: DictConfig, run_dir: Path, on_accepted: Callable[[DictConfig, Path
     with job_lock(run_dir):
         check_resumable(cfg, run_dir)
         check_same_meshes(run_dir, models)
+        pool = None
+        if is_clutter(cfg.mode):
+            pool = [models[n] for n in clutter_pool(objects, models)]
+            check_same_pool(run_dir, cfg.mode.name, pool, unusable)
         check_run_files(run_dir)
+        write_run_record(cfg, run_dir, models, pool)
         if on_accepted is not None:
             on_accepted(cfg, run_dir)
         return _run_trials(cfg, run_dir, objects, models, unusable, wall0, cpu0)
@@ -80,14 +101,19 @@ def _run_trials(
     if is_clutter(cfg.mode):
         return timed_rounds(cfg, run_dir, objects, models, wall0, cpu0)
     results: list[TrialResult] = []
+    rows = table_results(run_dir)  # the rows of record=false runs of this config (no log behind them)
     with tqdm(
         total=len(objects) * cfg.trials,
         desc=f"{cfg.mode.name}/{cfg.rot.name}/{cfg.dataset.name}",
         disable=not cfg.progress,
     ) as bar:
         for name in objects:
-            results.extend(run_object_trials(cfg, name, run_dir, bar, models.get(name) or unusable[name]))
-    results += kept_results(run_dir, {(r.object, r.trial) for r in results})
+            loaded = models.get(name) or unusable[name]
+            results.extend(run_object_trials(cfg, name, run_dir, bar, loaded, finished_rows=rows))
+    done = {(r.object, r.trial) for r in results}
+    results += kept_results(run_dir, done)
+    done |= {(r.object, r.trial) for r in results}
+    results += [row for key, row in rows.items() if key not in done]
     df, text = write_summary(run_dir, results, models, unusable)
     print(
         f"\n{cfg.mode.name} / rot {cfg.rot.name} / {cfg.dataset.name} / planner {cfg.planner.name}: {run_dir}"

@@ -51,11 +51,17 @@ def summary_markdown(table: pd.DataFrame) -> str:
     return shown.to_markdown(floatfmt=".3g")
 
 
-def object_notes(models: dict[str, LoadedObject], unusable: dict[str, str]) -> str:
-    """The summary's lines on what was assumed for each object and why an object could not be used
-    ("" when there is nothing to say)."""
+def object_notes(
+    models: dict[str, LoadedObject], unusable: dict[str, str], df: pd.DataFrame | None = None
+) -> str:
+    """The summary's lines on what was assumed for each object and why an object could not be used, with
+    how many of its finished trials (rows of the results table ``df``) were kept ("" when there is nothing
+    to say)."""
     lines = [f"- {name}: {'; '.join(o.notes)}" for name, o in models.items() if o.notes]
-    lines += [f"- {name}: NOT RUN, {why}" for name, why in unusable.items()]
+    for name, why in unusable.items():
+        n = 0 if df is None else len(ran(df[df["object"] == name]))
+        kept = f" (its {n} finished trial(s) from an earlier run are kept)" if n else ""
+        lines.append(f"- {name}: NOT RUN, {why}{kept}")
     return "\n\nObjects:\n" + "\n".join(lines) if lines else ""
 
 
@@ -86,7 +92,7 @@ def write_summary(
     summary's text)."""
     df = pd.DataFrame([r.to_dict() for r in results])
     csv = df.to_csv(index=False).encode()
-    text = summary_markdown(summarize(df)) + object_notes(models, unusable)
+    text = summary_markdown(summarize(df)) + object_notes(models, unusable, df)
     for path, data in ((results_csv(run_dir), csv), (summary_md(run_dir), (text + "\n").encode())):
         try:  # replaced whole, never written through a link planted in its place
             write_atomic(check_not_linked(path), lambda fh, data=data: fh.write(data))

@@ -4,6 +4,7 @@ exception inside a trial becomes that trial's ``error`` result, an unwritable lo
 import errno
 import logging
 import traceback
+from collections.abc import Mapping
 from pathlib import Path
 
 from omegaconf import DictConfig
@@ -33,12 +34,15 @@ def run_object_trials(
     run_dir: Path,
     bar: tqdm | None = None,
     loaded: LoadedObject | str | None = None,
+    *,
+    finished_rows: Mapping[tuple[str, int], TrialResult] | None = None,
 ) -> list[TrialResult]:
     """Every trial of one object; finished trials found in ``run_dir`` are read back instead of re-run.
 
     ``loaded``: the object from :func:`graspexp.run.objects.load_models`, or the reason it cannot be used
-    (then every trial is an ``error`` result with that reason); loaded here if None. An exception inside a
-    trial is that trial's ``error`` result; an unwritable log stops the job (RunError).
+    (then every trial without a finished result, a log or one of ``finished_rows``, is an ``error`` result
+    with that reason: :func:`_unusable_object_trials`); loaded here if None. An exception inside a trial is
+    that trial's ``error`` result; an unwritable log stops the job (RunError).
     """
     plain = plain_config(cfg)
     job_meta = job_metadata(cfg)
@@ -53,7 +57,7 @@ def run_object_trials(
     except OSError as exc:
         raise RunError(write_failure(first, exc)) from None
     if isinstance(loaded, str):
-        return _unusable_object_trials(cfg, object_name, run_dir, loaded, bar)
+        return _unusable_object_trials(cfg, object_name, run_dir, loaded, bar, finished_rows or {})
     results = []
     for i in range(cfg.trials):
         path = trial_log_path(run_dir, object_name, i)
@@ -97,22 +101,39 @@ def write_failure(path: Path, exc: BaseException, kind: str = "trial") -> str:
 
 
 def _unusable_object_trials(
-    cfg: DictConfig, object_name: str, run_dir: Path, reason: str, bar: tqdm | None
+    cfg: DictConfig,
+    object_name: str,
+    run_dir: Path,
+    reason: str,
+    bar: tqdm | None,
+    finished_rows: Mapping[tuple[str, int], TrialResult],
 ) -> list[TrialResult]:
-    """Every trial of an object that cannot be used: an ``error`` result with ``reason``, logged (when
-    ``record``) so that the report counts it; resume tries the object again."""
+    """Every trial of an object that cannot be used now. A trial that has a finished result, its complete log
+    or a row of ``finished_rows`` (a ``record=false`` run's), keeps it: nothing finished is overwritten by an
+    error (a damaged or ``error`` log is moved aside as on any resume). Each other trial is an ``error``
+    result with ``reason``, logged (when ``record``) so that the report counts it; resume tries the object
+    again."""
     plain, job_meta = plain_config(cfg), job_metadata(cfg)
-    results = []
+    results, kept = [], []
     for i in range(cfg.trials):
-        seed = trial_seed(plain, object_name, i)
-        result = error_result(cfg, object_name, i, seed, ObjectError(reason))
         path = trial_log_path(run_dir, object_name, i)
-        meta = unusable_trial_metadata(job_meta, object_name, i, seed)
-        with trial_recorder(path if cfg.record else None, meta, plain) as rec:
-            rec.result(0.0, result.to_dict())
+        result = finished_result(path, run_dir, object_name, i) or finished_rows.get((object_name, i))
+        if result is not None and result.reason != FailureReason.ERROR.value:
+            kept.append(f"{i} ({path if path.exists() else 'its row of results.csv'})")
+        else:
+            seed = trial_seed(plain, object_name, i)
+            result = error_result(cfg, object_name, i, seed, ObjectError(reason))
+            meta = unusable_trial_metadata(job_meta, object_name, i, seed)
+            with trial_recorder(path if cfg.record else None, meta, plain) as rec:
+                rec.result(0.0, result.to_dict())
         results.append(result)
         if bar is not None:
             bar.update()
+    if kept:
+        log.warning(
+            "%s cannot be used now; its finished trials are kept, not overwritten: %s; the other %d are not run",
+            object_name, ", ".join(kept), cfg.trials - len(kept),
+        )  # fmt: skip
     return results
 
 

@@ -9,7 +9,8 @@ The pose is the identity rotation translated so that the mesh's lowest point sit
 A job that renders the depth camera (``perception.source=depth``, or a planner that reads it) gets the
 camera's observation of the object on the support and, with ``perception.source=depth``, the pose
 registered from it, as a trial does (:func:`graspexp.perception.scene_view.perceive`, with that trial's
-seed).
+seed); a registration that fails its checks raises
+:class:`~graspexp.perception.scene_view.RegistrationFailed` (nothing is planned on the prior or the identity).
 """
 
 import dataclasses
@@ -68,7 +69,8 @@ def upright_request(cfg: Any, model: ObjectModel) -> PlanRequest:
 
 def posed_request(cfg: Any, model: ObjectModel, pose: np.ndarray, trial: int) -> PlanRequest:
     """The planning request for ``model`` at the (4,4) world ``pose`` on the support of job config ``cfg``,
-    with the planner seed of trial ``trial``: seen without error, or through the camera (module doc)."""
+    with the planner seed of trial ``trial``: seen without error, or through the camera (module doc; raises
+    :class:`~graspexp.perception.scene_view.RegistrationFailed` when no pose could be registered)."""
     req = PlanRequest(
         points=model.points @ pose[:3, :3].T + pose[:3, 3],
         normals=model.normals @ pose[:3, :3].T,
@@ -82,12 +84,14 @@ def posed_request(cfg: Any, model: ObjectModel, pose: np.ndarray, trial: int) ->
         seed=plan_seed(trial_seed(cfg, model.name, trial)),
         support_blocks_gripper=bool(cfg.mode.support_collides_with_gripper),
     )
-    from graspexp.perception.scene_view import perceive, wants_camera
+    from graspexp.perception.scene_view import RegistrationFailed, perceive, wants_camera
 
     if not wants_camera(cfg):
         return req
     plain = OmegaConf.to_object(cfg) if isinstance(cfg, DictConfig) else cfg
     seen = perceive(plain, model, pose, req.table_z, trial_seed(cfg, model.name, trial))
+    if not seen.ok:
+        raise RegistrationFailed(f"registration_failed: {seen.failure}")
     return dataclasses.replace(
         req,
         points=model.points @ seen.pose[:3, :3].T + seen.pose[:3, 3],
@@ -99,7 +103,8 @@ def posed_request(cfg: Any, model: ObjectModel, pose: np.ndarray, trial: int) ->
 
 def plan_upright(cfg: Any, model: ObjectModel) -> PlannedObject:
     """Place ``model`` upright on the support and plan with the configured planner (raises
-    :class:`~graspexp.planning.NoFeasibleGrasp` or :class:`~graspexp.planning.UnknownPlanner`)."""
+    :class:`~graspexp.planning.NoFeasibleGrasp`, :class:`~graspexp.planning.UnknownPlanner` or
+    :class:`~graspexp.perception.scene_view.RegistrationFailed`)."""
     req = upright_request(cfg, model)
     start = time.perf_counter()
     result = plan(req)

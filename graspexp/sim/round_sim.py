@@ -53,28 +53,40 @@ class RoundSim(TrialSim):
         self.gripper, self._links, self.touch = None, None, None
 
 
-def settle_all(sim: RoundSim) -> bool:
+def fastest_body(sim: RoundSim, names: list[str]) -> tuple[str, float, float]:
+    """Of the bodies ``names``, the one moving fastest now (by linear speed, then angular): (name, speed m/s,
+    angular speed rad/s)."""
+    best = ("", -1.0, -1.0)
+    for name in names:
+        body = sim.ts.bodies[name][1]
+        v, w = np.asarray(body.get_linear_velocity(), float), np.asarray(body.get_angular_velocity(), float)
+        speed = (float(np.linalg.norm(v)), float(np.linalg.norm(w)))
+        if speed > best[1:]:
+            best = (name, *speed)
+    return best
+
+
+def settle_all(sim: RoundSim) -> list[str]:
     """Step until every object rests (both settle speeds for ``sim.settle_hold_s``, after
-    ``sim.settle_min_s``) or ``sim.settle_max_s`` runs out; whether they came to rest."""
+    ``sim.settle_min_s``) or ``sim.settle_max_s`` runs out; the bodies that had not rested for
+    ``sim.settle_hold_s`` when it ran out ([]: all came to rest). The heap rests once its least still body
+    has rested long enough: each body's count of still steps is kept only to name the moving ones."""
     cfg = sim.cfg.sim
-    bodies = [b for _, b in sim.ts.bodies.values()]
+    bodies = [(name, b) for name, (_, b) in sim.ts.bodies.items()]
     if not bodies:
-        return True
+        return []
     sim.track(next(iter(sim.ts.bodies)))
     linear_sq, angular_sq = cfg.settle_linear_mps**2, cfg.settle_angular_radps**2
     min_steps, hold = int(cfg.settle_min_s / sim.dt), max(1, round(cfg.settle_hold_s / sim.dt))
-    still = 0
+    still = [0] * len(bodies)  # consecutive steps each body spent below both speeds
     with sim.timed("settle"):
         for i in range(int(cfg.settle_max_s / sim.dt)):
             sim.step()
-            rest = True
-            for body in bodies:
+            for k, (_, body) in enumerate(bodies):
                 v, w = body.get_linear_velocity(), body.get_angular_velocity()
-                if v.dot(v) >= linear_sq or w.dot(w) >= angular_sq:
-                    rest = False
-                    break
-            still = still + 1 if rest else 0
-            if i + 1 >= min_steps and still >= hold:
-                return True
-    sim.phase(Phase.SETTLE_TIMEOUT, {"cap_s": cfg.settle_max_s})
-    return False
+                still[k] = 0 if v.dot(v) >= linear_sq or w.dot(w) >= angular_sq else still[k] + 1
+            if i + 1 >= min_steps and min(still) >= hold:
+                return []
+    moving = [name for (name, _), n in zip(bodies, still, strict=True) if n < hold]
+    sim.phase(Phase.SETTLE_TIMEOUT, {"cap_s": cfg.settle_max_s, "moving": moving})
+    return moving

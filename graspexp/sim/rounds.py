@@ -9,6 +9,20 @@ exactly as a ``bin`` trial does (:func:`graspexp.sim.trial.execute_grasp`: appro
 hold; gripper-table contact fails it; touching a neighbour is allowed and recorded) and scores it. A held
 object is taken away; the others stay where the attempt left them and settle. The round ends when no
 object is left, the planner finds no grasp, or ``mode.max_consecutive_failures`` attempts in a row fail.
+
+The single-object rules hold for the heap too (:class:`graspexp.core.rounds.RoundEnd`): a round that placed
+nothing is ``nothing_placed``, not ``cleared``; a heap still moving when ``sim.settle_max_s`` runs out (after
+the placing or after an attempt; an object that left the table is taken away, not waited for) is never
+planned on: the round ends ``not_at_rest``, its last row (not executed) naming the object moving fastest.
+
+With ``perception.source=depth``, an object whose registration fails
+(:func:`graspexp.perception.registration.failure`) is no target of a planner that plans on poses
+(:func:`graspexp.perception.scene_view.plans_on_pose`; one that plans from the camera's cloud plans as
+usual): the planner plans for the others, and the object stays on the table, looked at again at the next
+attempt. With a prior it stays their obstacle at that prior (the pose estimator's output the registration
+started from); without one (``perception.registration.prior=none``) the planner knows nothing of it. When
+no object left can be registered, the attempt's row (not executed) records ``registration_failed`` for the
+first of them and the round ends ``no_grasp``.
 """
 
 import dataclasses
@@ -29,12 +43,15 @@ from graspexp.planning.grasp import Grasp
 from graspexp.planning.request import Neighbour, PlanRequest
 from graspexp.planning.scene import ScenePlanner, SceneRequest, TargetPlan, timed
 from graspexp.sim.round_scene import RoundObject, clutter_scene
-from graspexp.sim.round_sim import RoundSim, settle_all
+from graspexp.sim.round_sim import RoundSim, fastest_body, settle_all
 from graspexp.sim.scene_types import SceneType, scene_type
 from graspexp.sim.trial import LogSink, NullRecorder, QualityFn, TrialFailed, execute_grasp, grasp_record
 
 MOVED_M = 0.01
 """A neighbour whose origin ended farther than this from where it was before an attempt was moved by it, m."""
+NO_PLAN = float("nan")
+"""The planning times of an attempt row no plan was made for (a moving heap, nothing registered): NaN, left out
+of the latency percentiles."""
 PLANNING_MODE = "bin"
 """What a planner is told the mode is (:attr:`PlanRequest.mode`): the table under a clutter round is the
 bin's, so the paper's Eq. (2)-(3) score the paths."""
@@ -81,10 +98,11 @@ def run_round(ctx: RoundContext) -> RoundResult:
     if ctx.scene is not None:
         ctx.recorder.scene(0.0, ctx.scene.static)
     try:
-        _place(ctx, sim, kind)
+        moving = _place(ctx, sim, kind)
         res.placed = sorted(ts.bodies)
-        sim.phase(Phase.SETTLED, {"placed": res.placed})
-        res.end = _attempts(ctx, sim, res).value
+        if not moving:
+            sim.phase(Phase.SETTLED, {"placed": res.placed})
+        res.end = (_attempts(ctx, sim, res, moving) if res.placed else RoundEnd.NOTHING_PLACED).value
     except TrialFailed as e:  # the scene itself went unstable while settling
         res.error = str(e)
         sim.phase(Phase.FAILED, {"reason": e.reason.value, "detail": str(e)})
@@ -94,13 +112,23 @@ def run_round(ctx: RoundContext) -> RoundResult:
     return res
 
 
-def _place(ctx: RoundContext, sim: RoundSim, kind: SceneType) -> None:
+def _place(ctx: RoundContext, sim: RoundSim, kind: SceneType) -> list[str]:
     """Bring the drawn objects onto the table as the scene type does, settle, and take away every object
-    outside the workspace or off the table."""
+    outside the workspace or off the table; the objects left that were still moving when ``sim.settle_max_s``
+    ran out (:func:`_settle`)."""
     sim.phase(Phase.DROP, {"objects": [o.model.name for o in ctx.objects]})
     kind.place(sim, ctx.objects, rng_for(ctx.round_seed, "place"))
-    settle_all(sim)
+    return _settle(ctx, sim)
+
+
+def _settle(ctx: RoundContext, sim: RoundSim) -> list[str]:
+    """Let the scene come to rest (:func:`graspexp.sim.round_sim.settle_all`), take away every object outside
+    the workspace or off the table, and return the bodies left that had not come to rest ([]: the heap the
+    planner looks at rests; one that rolled off the table and still moves on the floor is taken away, not
+    waited for)."""
+    moving = settle_all(sim)
     _take_away_outside(ctx, sim)
+    return [b for b in moving if b in sim.ts.bodies]
 
 
 def _take_away_outside(ctx: RoundContext, sim: RoundSim) -> list[str]:
@@ -126,13 +154,16 @@ def _remove(ctx: RoundContext, sim: RoundSim, name: str) -> None:
         ctx.recorder.delete_entities(sim.log_t, ctx.scene.bodies[name])
 
 
-def _attempts(ctx: RoundContext, sim: RoundSim, res: RoundResult) -> RoundEnd:
-    """Grasp until the table is clear, no grasp is found, or the failure limit; each attempt's row into
-    ``res.attempts``."""
+def _attempts(ctx: RoundContext, sim: RoundSim, res: RoundResult, moving: list[str]) -> RoundEnd:
+    """Grasp until the table is clear, no grasp is found, the failure limit, or a heap still moving before an
+    attempt (``moving``: the bodies that were after the placing); each attempt's row into ``res.attempts``."""
     cfg, ts = ctx.cfg, sim.ts
     failures = 0
     attempt = 0
     while ts.bodies:
+        if moving:  # never planned on a moving heap (a single-object trial's not_at_rest)
+            res.attempts.append(_not_at_rest(ctx, sim, attempt, moving))
+            return RoundEnd.NOT_AT_REST
         seed = derive_seed(ctx.round_seed, "attempt", attempt)
         row, grasp = _plan_scene(ctx, sim, attempt, seed)
         if grasp is None:
@@ -162,8 +193,7 @@ def _attempts(ctx: RoundContext, sim: RoundSim, res: RoundResult) -> RoundEnd:
             Phase.ATTEMPT_END,
             {"attempt": attempt, "target": name, "success": row.success, "reason": row.reason},
         )
-        settle_all(sim)
-        _take_away_outside(ctx, sim)
+        moving = _settle(ctx, sim)
         row.moved_neighbours = sorted(
             b
             for b, p in before.items()
@@ -176,6 +206,23 @@ def _attempts(ctx: RoundContext, sim: RoundSim, res: RoundResult) -> RoundEnd:
         if failures >= cfg.mode.max_consecutive_failures:
             return RoundEnd.FAILURE_LIMIT
     return RoundEnd.CLEARED
+
+
+def _not_at_rest(ctx: RoundContext, sim: RoundSim, attempt: int, moving: list[str]) -> AttemptResult:
+    """The row of an attempt not made because bodies ``moving`` had not come to rest when ``sim.settle_max_s``
+    ran out: not executed, reason ``not_at_rest``, its target the one moving fastest now (logged with its
+    speeds)."""
+    cfg = ctx.cfg
+    name, speed, spin = fastest_body(sim, moving)
+    slot = int(name.rsplit("_", 1)[1])
+    sim.phase(Phase.FAILED, {"reason": FailureReason.NOT_AT_REST.value, "target": name, "moving": moving,
+                             "speed_mps": speed, "angular_radps": spin, "cap_s": cfg.sim.settle_max_s,
+                             "detail": "the heap was still moving when sim.settle_max_s ran out"})  # fmt: skip
+    return AttemptResult(
+        round=ctx.round, attempt=attempt, target=ctx.objects[slot].model.name, slot=slot, executed=False,
+        success=False, reason=FailureReason.NOT_AT_REST.value, pick_order=cfg.mode.pick_order,
+        n_left=len(sim.ts.bodies), n_planned=0, plan_s=NO_PLAN, plan_cpu_s=NO_PLAN, sim_time_s=sim.t,
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -192,19 +239,24 @@ def _plan_scene(
     ctx: RoundContext, sim: RoundSim, attempt: int, seed: int
 ) -> tuple[AttemptResult, Grasp | None]:
     """Plan the next grasp of the scene (``mode.pick_order``); the attempt's row and the grasp (None: none
-    found on any object). Every object is seen at its perceived pose (``perception.noise``)."""
+    found on any object, or none could be registered). Every object is seen at its perceived pose
+    (``perception.noise``); with ``perception.source=depth`` only the registered ones are targets (module
+    doc)."""
     cfg, ts = ctx.cfg, sim.ts
     slots = {name: int(name.rsplit("_", 1)[1]) for name in ts.bodies}
     view = perceive_scene(
         cfg, {s: (ctx.objects[s].model, ts.pose_of(name)) for name, s in slots.items()}, ts.table_z, seed
     )
+    obstacles = {} if cfg.perception.registration.prior == "none" else view.priors
     seen = {
-        name: _Seen(
-            slot, view.poses[slot], transform_points(view.poses[slot], ctx.objects[slot].model.points)
-        )
+        name: _Seen(slot, pose, transform_points(pose, ctx.objects[slot].model.points))
         for name, slot in slots.items()
+        if (pose := view.poses.get(slot, obstacles.get(slot))) is not None
     }
-    order = sorted(seen)
+    unregistered = {name: view.failed[slot] for name, slot in slots.items() if slot not in view.poses}
+    order = sorted(b for b in seen if b not in unregistered)
+    if not order:
+        return _none_registered(ctx, sim, attempt, view, unregistered), None
     if cfg.mode.pick_order == "top_most":
         order.sort(key=lambda b: -float(seen[b].points[:, 2].max()))
     half = np.asarray(cfg.mode.workspace_half_size_m, dtype=np.float64)
@@ -226,9 +278,10 @@ def _plan_scene(
     )  # fmt: skip
     _pose_errors(row, view.errors.get(first))
     chosen = min((tp for tp in found.plans if tp.grasp is not None), key=_preference, default=None)
+    unseen = {"unregistered": unregistered} if unregistered else {}
     if chosen is None:
         _log_camera(ctx, sim, view, order[0], first)
-        sim.phase(Phase.PLAN, {"attempt": attempt, "found": False, "n_planned": n})
+        sim.phase(Phase.PLAN, {"attempt": attempt, "found": False, "n_planned": n, **unseen})
         return row, None
     name, grasp = order[chosen.index], chosen.grasp
     slot = seen[name].slot
@@ -237,9 +290,29 @@ def _plan_scene(
     row.grasp_cost, row.grasp_width_m, row.n_feasible = grasp.cost, grasp.width_m, grasp.n_feasible
     _pose_errors(row, view.errors.get(slot))
     sim.phase(Phase.PLAN, {"attempt": attempt, "target": name, "object": row.target, "n_planned": n,
-                           "pick_order": cfg.mode.pick_order, "plan_s": wall})  # fmt: skip
+                           "pick_order": cfg.mode.pick_order, "plan_s": wall, **unseen})  # fmt: skip
     ctx.recorder.grasp(sim.log_t, {**grasp_record(grasp), "target": name})
     return row, grasp
+
+
+def _none_registered(
+    ctx: RoundContext, sim: RoundSim, attempt: int, view: ScenePerceived, unregistered: dict[str, str]
+) -> AttemptResult:
+    """The row of an attempt whose camera registered no object left (``unregistered``: body -> why): not
+    executed, reason ``registration_failed``, its target the first of them (its fitness, no pose error)."""
+    cfg = ctx.cfg
+    name = sorted(unregistered)[0]
+    slot = int(name.rsplit("_", 1)[1])
+    row = AttemptResult(
+        round=ctx.round, attempt=attempt, target=ctx.objects[slot].model.name, slot=slot, executed=False,
+        success=False, reason=FailureReason.REGISTRATION_FAILED.value, pick_order=cfg.mode.pick_order,
+        n_left=len(sim.ts.bodies), n_planned=0, plan_s=NO_PLAN, plan_cpu_s=NO_PLAN, sim_time_s=sim.t,
+    )  # fmt: skip
+    _pose_errors(row, view.errors.get(slot))
+    _log_camera(ctx, sim, view, name, slot)
+    sim.phase(Phase.PLAN, {"attempt": attempt, "found": False, "n_planned": 0, "unregistered": unregistered})
+    sim.phase(Phase.FAILED, {"reason": row.reason, "detail": unregistered[name], "target": name})
+    return row
 
 
 def _preference(tp: TargetPlan) -> tuple[bool, float, int]:
@@ -297,7 +370,9 @@ def _log_camera(ctx: RoundContext, sim: RoundSim, view: ScenePerceived, name: st
     poses = {"object_true": sim.ts.pose_of(name), "object_prior": view.priors[slot]}
     info: dict = {"source": ctx.cfg.perception.source}
     if slot in view.errors:
-        info.update(view.errors[slot], estimated_pose=view.poses[slot])
+        info.update(view.errors[slot])
+    if slot in view.errors and slot in view.poses:
+        info["estimated_pose"] = view.poses[slot]
     frames = {v.name: v.world_from_camera for v in obs.views}
     sim.rec.transforms(sim.log_t, {k: (T[:3, 3], matrix_to_quat_wxyz(T[:3, :3])) for k, T in frames.items()})
     ctx.recorder.perception(sim.log_t, dataclasses.replace(obs, target_id=slot_id(slot)), poses, info)

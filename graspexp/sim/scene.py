@@ -180,5 +180,6 @@ def _object_shapes(
             sapien.physx.PhysxCollisionShapeConvexMesh(vertices=v, scale=one, material=material)
             for v, _ in shape.parts
         ]
-    # from the file: SAPIEN cooks it (SDF included) once per process and reuses it
-    return [sapien.physx.PhysxCollisionShapeTriangleMesh(str(shape.mesh_file), one, material, sdf=True)]
+    # from the file: SAPIEN cooks it (SDF included) once per process and reuses it, at any scale
+    scale = one if shape.file_scale == 1.0 else np.full(3, shape.file_scale, dtype=np.float32)
+    return [sapien.physx.PhysxCollisionShapeTriangleMesh(str(shape.mesh_file), scale, material, sdf=True)]

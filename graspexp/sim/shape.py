@@ -25,6 +25,9 @@ class CollisionShape:
     sha256: str = ""
     """SHA-256 of the shape itself (its parts' float32 vertices and int64 faces): what every trial that used
     it collided with, recorded in each log ("" if not computed)."""
+    file_scale: float = 1.0
+    """Uniform factor PhysX applies to ``mesh_file`` (a round's scaled object, ``mode.object_scale``: its
+    ``parts`` are scaled already, the cooked file and its SDF are shared and scaled by PhysX); 1: as the file is."""
 
     def meshes(self) -> list[trimesh.Trimesh]:
         """The parts as triangle meshes (object frame, metres)."""

@@ -45,6 +45,7 @@ class TrialFailed(Exception):
     def __init__(self, reason: FailureReason, detail: str = ""):
         super().__init__(f"{reason.value}: {detail}" if detail else reason.value)
         self.reason = reason
+        self.detail = detail
 
 
 class LogSink(Protocol):
@@ -395,7 +396,7 @@ def run_trial(ctx: TrialContext) -> TrialResult:
             execute_grasp(sim, grasp, res, ctx.scene)
         res.success = True
     except TrialFailed as e:
-        res.reason = e.reason.value
+        res.reason, res.detail = e.reason.value, e.detail
         if sim is not None:
             sim.phase(Phase.FAILED, {"reason": e.reason.value, "detail": str(e)})
     if sim is not None:
@@ -446,6 +447,8 @@ def _plan(ctx: TrialContext, sim: TrialSim, res: TrialResult) -> Grasp:
     seen = perceive(cfg, ctx.model, true_pose, sim.ts.table_z, ctx.trial_seed)
     if seen.observation is not None:
         _record_perception(ctx, sim, res, seen, true_pose)
+    if not seen.ok:  # never planned on the prior or the identity the registration was left at
+        raise TrialFailed(FailureReason.REGISTRATION_FAILED, seen.failure)
     req = PlanRequest(
         points=transform_points(seen.pose, ctx.model.points),
         normals=ctx.model.normals @ seen.pose[:3, :3].T,
@@ -475,9 +478,10 @@ def _record_perception(
     """The camera's frames, cloud and poses into the log; the pose errors and timings into the result."""
     reg = seen.registration
     if reg is not None:
-        res.pose_trans_err_mm = seen.errors["trans_mm"]
-        res.pose_rot_err_deg = seen.errors["rot_deg"]
-        res.pose_adds_mm = seen.errors["adds_mm"]
+        if reg.ok:  # a failed registration registered no pose: its errors stay NaN
+            res.pose_trans_err_mm = seen.errors["trans_mm"]
+            res.pose_rot_err_deg = seen.errors["rot_deg"]
+            res.pose_adds_mm = seen.errors["adds_mm"]
         res.registration_fitness = reg.fitness
         res.registration_cpu_s = reg.cpu_s
     if sim.recording:

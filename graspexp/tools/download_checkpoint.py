@@ -27,6 +27,7 @@ from graspexp.core.checkpoints import (
     Checkpoint,
     checkpoint_dir,
     checkpoint_dirs,
+    path_kind,
 )
 from graspexp.datasets.download import fetch
 from graspexp.datasets.errors import DatasetError
@@ -56,6 +57,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     ckpt = known[args.name]
     found = [d / ckpt.filename for d in checkpoint_dirs() if (d / ckpt.filename).is_file()]
     folder = (args.dir or (found[0].parent if found else checkpoint_dir())).expanduser()
+    kind = path_kind(folder / ckpt.filename)
+    if kind:  # a folder, /dev/zero: nothing to hash or overwrite there
+        print(
+            f"{PROG}: error: {folder / ckpt.filename} is {kind}, not a regular file: remove it",
+            file=sys.stderr,
+        )
+        return 2
     try:
         path = fetch(args.url or ckpt.url, folder, ckpt.filename, ckpt.sha256, progress=not args.quiet)
     except DatasetError as err:

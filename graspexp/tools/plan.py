@@ -15,8 +15,9 @@ drives the drop in the simulated trials). Seeds match the runner's trial 0.
 
 Printed keys: ``object``, ``dataset``, ``mode``, ``pose`` (4x4 list, world, metres), ``width`` (m),
 ``cost``, ``cluster``, ``path``, ``K``, ``M``, ``n_feasible``, ``plan_ms`` (wall time of the planner
-call). A bad argument, an unknown object or a plan with no feasible grasp prints one
-``graspexp.tools.plan: error:`` line on stderr and exits with status 2, without a traceback.
+call). A bad argument, an unknown object, a clutter mode (``mode=pile``/``packed``: this tool plans one
+object alone), a pose the camera could not register (``perception.source=depth``) or a plan with no feasible
+grasp prints one ``graspexp plan: error:`` line on stderr and exits with status 2, without a traceback.
 """
 
 import json
@@ -27,8 +28,10 @@ from pathlib import Path
 import numpy as np
 from omegaconf import DictConfig
 
+from graspexp.config.mode import is_clutter
 from graspexp.core.files import write_atomic
 from graspexp.datasets import DatasetError, job_object
+from graspexp.perception.scene_view import RegistrationFailed
 from graspexp.planning import NoFeasibleGrasp, UnknownPlanner
 from graspexp.run.upright import PlannedObject, plan_upright
 from graspexp.tools.cli import compose_checked, fail, tool_parser
@@ -68,12 +71,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--dump", metavar="FILE.npz", help="save every intermediate of the plan")
     args = parser.parse_intermixed_args(argv)
     cfg = compose_checked(args.overrides, PROG)
+    if is_clutter(cfg.mode):
+        fail(
+            f"mode={cfg.mode.name} is a clutter scene; plan plans one object standing alone (mode=collab or "
+            f"mode=bin): run a round with `python -m graspexp mode={cfg.mode.name} objects=[...] trials=1`",
+            PROG,
+        )
     if not cfg.objects or len(cfg.objects) != 1:
         fail("name the one object to plan for: objects=[NAME], e.g. objects=[025_mug]", PROG)
     name = str(cfg.objects[0])
     try:
         planned = plan_upright(cfg, job_object(cfg, name))
-    except (DatasetError, NoFeasibleGrasp, UnknownPlanner) as err:
+    except (DatasetError, NoFeasibleGrasp, UnknownPlanner, RegistrationFailed) as err:
         fail(f"{name}: {err}" if not isinstance(err, DatasetError) else str(err), PROG)
     if args.dump:
         try:

@@ -12,7 +12,8 @@ Each page's sweeps run as Hydra multiruns (joblib launcher) into ``OUT/runs/`` (
 hydra.launcher.partition=P`` (SLURM) or ``hydra.launcher.n_jobs=4``. The pages are
 :func:`graspexp.run.result_pages.pages`; ``--learned-planners`` selects those that run a learned planner
 (``nox -s learned`` checks them). Exit status: 0; 1 when a sweep failed or (``--check``) a page is
-not current; 2 on a bad option.
+not current; 2 on a bad option or, before any sweep runs, a page file that is missing, lacks its generated
+block or cannot be written (a read-only root), or an ``--out`` that cannot be made.
 """
 
 import shlex

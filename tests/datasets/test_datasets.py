@@ -200,7 +200,9 @@ def test_dataset_objects_default_and_subset():
 def test_unknown_object_lists_valid_names():
     with pytest.raises(DatasetError, match=r"unknown object 'mugg'.*valid names: .*025_mug"):
         load_object(make_cfg("ycb", "/nonexistent"), "mugg", 16, 0)
-    with pytest.raises(DatasetError, match=r"unknown dataset 'shapenet'.*linemod, primitives, ycb"):
+    with pytest.raises(
+        DatasetError, match=r"unknown dataset 'shapenet'.*linemod, primitives, vgn_packed, vgn_pile, ycb"
+    ):
         load_object(DatasetConfig(name="shapenet", regions="ycb.yaml"), "x", 16, 0)
 
 

@@ -180,7 +180,7 @@ def test_round_trip_file(trial_file):
         "/contacts": "foxglove.PointCloud",
         "/grasp": "graspexp.PlannedGrasp@1",
         "/phase": "graspexp.Phase@1",
-        "/result": "graspexp.TrialResult@4",
+        "/result": "graspexp.TrialResult@5",
     }
     n = int(RATE_HZ * DURATION_S)
     assert sorted(log.transforms) == ["finger_left", "finger_right", "gripper", "object"]
@@ -312,7 +312,7 @@ def test_scene_entities_follow_foxglove_layout(trial_file):
 
 def test_result_schema_pinned():
     """Changing TrialResult's fields must come with a new graspexp.TrialResult@N version."""
-    assert S.TRIAL_RESULT == "graspexp.TrialResult@4"
+    assert S.TRIAL_RESULT == "graspexp.TrialResult@5"
     assert list(S.SCHEMAS[S.TRIAL_RESULT]["properties"]) == [
         "dataset",
         "object",
@@ -341,6 +341,7 @@ def test_result_schema_pinned():
         "pose_adds_mm",
         "registration_fitness",
         "registration_cpu_s",
+        "detail",
     ]
 
 

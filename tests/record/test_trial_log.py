@@ -63,7 +63,7 @@ def test_log_reads_back_with_expected_topics_and_schemas(two_runs):
     assert log.topics["/scene"] == "foxglove.SceneUpdate"
     assert log.topics["/contacts"] == "foxglove.PointCloud"
     assert log.topics["/grasp"] == "graspexp.PlannedGrasp@1"
-    assert log.topics["/result"] == "graspexp.TrialResult@4"
+    assert log.topics["/result"] == "graspexp.TrialResult@5"
     assert {"object", "palm", "finger_left", "finger_right"} <= set(log.transforms)
     assert log.metadata["object"] == "box" and "config_yaml" in log.metadata
     times, _, _ = log.transforms["object"]

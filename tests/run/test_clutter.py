@@ -2,6 +2,7 @@
 pile round of procedural objects through the runner, its log and its resume."""
 
 import dataclasses
+import importlib.util
 
 import numpy as np
 import pytest
@@ -12,6 +13,7 @@ from graspexp.config.compose import compose_validated
 from graspexp.core.geometry import make_pose
 from graspexp.core.rounds import RoundEnd, RoundResult
 from graspexp.core.seeding import round_seed
+from graspexp.perception.scene_view import slot_id
 from graspexp.planning import plan
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
 from graspexp.planning.request import PlanResult
@@ -244,3 +246,116 @@ def test_a_clutter_jobs_objective_is_its_gsr_and_zero_when_no_grasp_was_attempte
 
     assert round_objective([rnd((True, True), (True, False)), rnd((False, False))]) == 0.5
     assert round_objective([rnd((False, False)), rnd()]) == 0.0
+
+
+# issue 51: clutter rounds follow the single-object rules (findings 1 and 9)
+
+
+def _scene_round(mode: str, objects: list[str], *overrides: str) -> tuple[RoundResult, list]:
+    """(round 0 of ``objects``, every SceneRequest its planner got), as :func:`_round`."""
+    asked = []
+
+    def spy(req):
+        asked.append(req)
+        return per_object(plan)(req)
+
+    cfg = compose_cfg(
+        f"mode={mode}", "dataset=primitives", f"mode.objects_per_round={len(objects)}", *overrides
+    )
+    make_ready(cfg)
+    plain = plain_config(cfg)
+    loaded = [load_sim_object(cfg, name, plain) for name in objects]
+    return run_round(round_context(plain, loaded, 0, round_seed(plain, 0), planner=spy)), asked
+
+
+def test_no_attempt_is_planned_on_objects_the_camera_cannot_see():
+    """``perception.source=depth`` with the camera 10 m away: no object can be registered, so nothing is
+    planned; the round ends as a no-grasp round, its one row (not executed) ``registration_failed``."""
+    res, asked = _scene_round("pile", ["can", "box", "mug"], "perception.source=depth",
+                              "perception.camera.distance_m=10")  # fmt: skip
+    assert asked == [] and res.end == RoundEnd.NO_GRASP.value and res.removed == [], res
+    (row,) = res.attempts
+    assert not row.executed and row.reason == "registration_failed" and row.n_planned == 0
+    assert row.registration_fitness == 0.0 and np.isnan(row.pose_adds_mm)
+
+
+def test_an_object_whose_registration_failed_is_no_target_and_stays_on_the_table(monkeypatch):
+    """An object the camera could not register (here: slot 0, made to fail) is never a target; the others are
+    planned and grasped (it stays their obstacle at its prior); once only it is left, the attempt records
+    ``registration_failed`` and the round ends ``no_grasp``."""
+    import graspexp.sim.rounds as rounds
+
+    real = rounds.perceive_scene
+
+    def slot_0_unseen(cfg, objects, table_z, seed):
+        view = real(cfg, objects, table_z, seed)
+        poses = {s: p for s, p in view.poses.items() if s != 0}
+        return dataclasses.replace(view, poses=poses, failed={0: "test: unseen"} if 0 in objects else {})
+
+    monkeypatch.setattr(rounds, "perceive_scene", slot_0_unseen)
+    res, asked = _scene_round("packed", ["can", "bottle"])
+    assert asked and all(slot_id(0) not in req.ids for req in asked)
+    assert all(0 in {n.id for n in t.neighbours} for req in asked for t in req.targets)
+    assert res.removed == ["object_1"] and res.end == RoundEnd.NO_GRASP.value, res
+    assert [(a.target, a.executed, a.reason) for a in res.attempts] == [
+        ("bottle", True, None),
+        ("can", False, "registration_failed"),
+    ]
+
+
+def test_a_heap_still_moving_is_never_planned_on():
+    """``sim.settle_max_s=0.01``: the heap still falls when the planner would look; as a single-object trial,
+    nothing is planned: the round ends ``not_at_rest``, its one row (not executed) names a moving object."""
+    res, asked = _scene_round("pile", ["can", "box", "mug"], "sim.settle_min_s=0", "sim.settle_max_s=0.01")
+    assert asked == [] and res.end == RoundEnd.NOT_AT_REST.value and res.removed == [], res
+    (row,) = res.attempts
+    assert not row.executed and row.reason == "not_at_rest" and row.n_left == len(res.placed) > 0
+
+
+def test_a_round_that_placed_nothing_is_not_cleared():
+    """A workspace of 2 mm: every object is taken away, nothing is placed; the round is ``nothing_placed``
+    (not ``cleared``) and the clutter table counts it among no planner's rounds."""
+    from graspexp.report.round_tables import clutter_table
+
+    res, asked = _scene_round("packed", ["can", "box"], "mode.workspace_half_size_m=[0.001,0.001]")
+    assert res.placed == [] and res.end == RoundEnd.NOTHING_PLACED.value and asked == [] and not res.attempts
+    row = clutter_table([res]).iloc[0]
+    assert row["rounds"] == 0 and row["end_nothing_placed"] == 1 and row["end_cleared"] == 0
+
+
+def test_a_clutter_job_whose_every_round_erred_is_refused(tmp_path, monkeypatch):
+    """As a single-object job none of whose trials ran: a clutter job whose every round ended in an error
+    raises RunError (exit status 2 from the command line), naming the first error."""
+    import graspexp.run.round_loop as round_loop
+    from graspexp.run.locks import RunError
+    from graspexp.run.runner import run_in_dir
+
+    def broken(ctx):
+        raise RuntimeError("test: the planner cannot load")
+
+    monkeypatch.setattr(round_loop, "run_round", broken)
+    cfg = compose_cfg("mode=pile", "dataset=primitives", "objects=[can]", "trials=2", "progress=false",
+                      "mode.objects_per_round=1", "record=false")  # fmt: skip
+    with pytest.raises(RunError, match=r"^no round ran: every one of the 2 rounds ended in an error \(first: "
+                       r"RuntimeError: test: the planner cannot load\)$"):  # fmt: skip
+        run_in_dir(cfg, tmp_path / "run")
+
+
+@pytest.mark.slow
+def test_a_pile_job_with_a_corrupted_vgn_checkpoint_exits_2_as_bin_does(tmp_path):
+    """The issue's command: ``planner=vgn`` with a checkpoint that fails its hash, ``mode=pile``: every round
+    errs, and the job exits 2 with one line, as ``mode=bin`` does."""
+    from helpers.cli import one_error_line, run_job
+
+    from graspexp.config.planner.vgn import EXTRA_MODULES
+    from graspexp.core.checkpoints import VGN
+
+    if any(importlib.util.find_spec(m) is None for m in EXTRA_MODULES):
+        pytest.skip("planner=vgn needs the optional extra 'learned'")
+    (tmp_path / "ckpt").mkdir()
+    (tmp_path / "ckpt" / VGN.filename).write_bytes(bytes(VGN.size_bytes))
+    env = {"GRASPEXP_CHECKPOINTS": str(tmp_path / "ckpt")}
+    overrides = ("planner=vgn", "gripper=panda", "dataset=primitives", "objects=[can]", "trials=1")
+    for mode, extra in (("bin", ()), ("pile", ("mode.objects_per_round=1",))):  # one can: a heap at rest
+        line = one_error_line(run_job(tmp_path / mode, f"mode={mode}", *overrides, *extra, env=env))
+        assert "SHA-256" in line and ("no round ran" if mode == "pile" else "no trial ran") in line, line

@@ -214,7 +214,7 @@ def test_the_camera_and_learned_pages_fingerprint_jobs_compose(name):
 
     page = next(p for p in PAGES if p.name == name)
     jobs = fingerprint_jobs(page)
-    assert 0 < len(jobs) <= 10
+    assert 0 < len(jobs) <= 12
     cfgs = {job: compose_config(list(job)) for job in jobs}
     for job, cfg in cfgs.items():
         assert cfg.record is False and int(cfg.trials) == 1, job
@@ -227,16 +227,18 @@ def test_the_camera_clutter_pages_fingerprint_is_one_round_per_planner_and_scene
     """The camera clutter page's fingerprint: one round of each of its planners in pile and packed, every
     pose registered from the camera, vgn on the Panda it was trained for."""
     from graspexp.config.compose import compose_config
+    from graspexp.config.plugins import learned_planners
 
     page = next(p for p in PAGES if p.name == "clutter_camera")
     jobs = [compose_config(list(job)) for job in fingerprint_jobs(page)]
     runs = {(cfg.planner.name, cfg.mode.name) for cfg in jobs}
-    planners = {"optimal", "optimal_plus", "antipodal_view", "vgn"}
-    assert len(jobs) == 8 and runs == {(p, m) for p in planners for m in ("pile", "packed")}
+    planners = {"optimal", "optimal_plus", "antipodal_view", *learned_planners()}
+    assert len(jobs) == 2 * len(planners) and runs == {(p, m) for p in planners for m in ("pile", "packed")}
     for cfg in jobs:
         assert int(cfg.trials) == 1 and cfg.record is False and cfg.dataset.name == "ycb"
         assert cfg.perception.source == "depth" and cfg.perception.noise.trans_mm == 10
-        assert (cfg.gripper.name == "panda") == (cfg.planner.name == "vgn")
+        trained = learned_planners().get(cfg.planner.name)
+        assert cfg.gripper.name == (trained.gripper if trained else "rg2")
 
 
 def test_a_page_whose_planner_cannot_run_here_is_skipped_with_one_line(monkeypatch, capsys):

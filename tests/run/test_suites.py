@@ -98,15 +98,17 @@ def test_a_learned_plugin_joins_the_pages_and_columns_without_an_edit(fake_learn
 
     assert learned_columns() == (
         ("fakenet", False, "fakenet, gripper=robotiq_2f85, camera views"),
+        ("giga", False, "giga, gripper=panda, camera views"),
         ("vgn", False, "vgn, gripper=panda, camera views"),
     )
     pages = {p.name: p for p in result_pages.pages()}
     camera = pages["camera"]
-    assert _names(camera.sweeps)[-2:] == ["fakenet_robotiq_2f85", "vgn_panda"]
-    fake = camera.sweeps[-2].reading.overrides
+    assert _names(camera.sweeps)[-3:] == ["fakenet_robotiq_2f85", "giga_panda", "vgn_panda"]
+    fake = camera.sweeps[-3].reading.overrides
     assert fake == ("planner=fakenet", "gripper=robotiq_2f85", "dataset=ycb", "record=false")
     assert "fakenet_robotiq_2f85" in _names(camera.fingerprint)
-    assert _names(pages["learned"].sweeps) == ["fakenet_robotiq_2f85", "fakenet_rg2", "vgn_panda", "vgn_rg2"]
+    learned = ["fakenet_robotiq_2f85", "fakenet_rg2", "giga_panda", "giga_rg2", "vgn_panda", "vgn_rg2"]
+    assert _names(pages["learned"].sweeps) == learned
     assert pages["learned"].sweeps[1].reading.what == "fakenet on the paper's gripper (a transfer)"
     clutter = pages["clutter_camera"]
     assert "clutter_camera_fakenet" in _names(clutter.sweeps)
@@ -123,6 +125,7 @@ def test_bench_learned_and_download_checkpoint_take_a_learned_plugin(fake_learne
 
     assert bench_jobs([]) == [
         ["planner=fakenet", "gripper=robotiq_2f85", "dataset=ycb", "mode=bin"],
+        ["planner=giga", "gripper=panda", "dataset=ycb", "mode=bin"],
         ["planner=vgn", "gripper=panda", "dataset=ycb", "mode=bin"],
     ]
     assert bench_jobs(["planner=fakenet", "gripper=rg2", "objects=[025_mug]"]) == [
@@ -133,9 +136,13 @@ def test_bench_learned_and_download_checkpoint_take_a_learned_plugin(fake_learne
 
 
 def test_without_learned_planners_the_pages_keep_their_other_sweeps(monkeypatch):
-    """No learned planner installed (vgn's entry point gone): no learned page, no learned column or row."""
+    """No learned planner installed (vgn's and giga's entry points gone): no learned page, no learned column or
+    row."""
     installed = plugins.load_planners()
-    monkeypatch.setattr(plugins, "load_planners", lambda: {k: v for k, v in installed.items() if k != "vgn"})
+    learned = set(plugins.learned_planners())
+    monkeypatch.setattr(
+        plugins, "load_planners", lambda: {k: v for k, v in installed.items() if k not in learned}
+    )
     pages = {p.name: p for p in result_pages.pages()}
     assert "learned" not in pages and learned_pages(list(pages.values())) == []
     assert _names(pages["camera"].sweeps)[-1] == "antipodal_view"

@@ -90,3 +90,55 @@ def test_a_checkpoint_is_found_in_any_folder_of_the_variable(tmp_path, monkeypat
     assert "has 1 bytes" in checkpoints.missing_reason(checkpoints.VGN)
     monkeypatch.setenv(checkpoints.CHECKPOINTS_ENV, str(first))
     assert checkpoints.checkpoint_path(checkpoints.VGN) == first / checkpoints.VGN.filename
+
+
+@pytest.mark.parametrize(
+    ("make", "what"),
+    [
+        (lambda p: p.mkdir(), "is a folder, not a regular file: remove it and run `python -m graspexp"),
+        (lambda p: p.symlink_to("/dev/zero"), "is a character device, not a regular file: remove it and run"),
+        (lambda p: os.mkfifo(p), "is a named pipe, not a regular file"),
+        (lambda p: p.symlink_to(p.parent / "gone"), "is a link to nothing, not a regular file"),
+    ],
+    ids=["folder", "dev-zero", "fifo", "dangling-link"],
+)
+def test_a_checkpoint_that_is_no_regular_file_says_what_it_is_and_is_never_read(
+    tmp_path, monkeypatch, make, what
+):
+    """A folder or ``/dev/zero`` in the checkpoint's place is named for what it is (not "not found"), and
+    refused before a byte is read (hashing ``/dev/zero`` would never end)."""
+    monkeypatch.setenv(checkpoints.CHECKPOINTS_ENV, str(tmp_path))
+    make(tmp_path / checkpoints.VGN.filename)
+    monkeypatch.setattr(type(tmp_path), "read_bytes", lambda self: pytest.fail(f"{self} was read"))
+    why = checkpoints.missing_reason(checkpoints.VGN)
+    assert why.startswith(f"checkpoint {tmp_path / checkpoints.VGN.filename} {what}") and "\n" not in why
+    with pytest.raises(checkpoints.CheckpointError, match="not a regular file"):
+        checkpoints.read_verified(checkpoints.VGN)
+
+
+def test_an_unreadable_checkpoint_or_a_variable_naming_a_file_is_said_so(tmp_path, monkeypatch):
+    path = tmp_path / checkpoints.VGN.filename
+    path.write_bytes(b"x" * checkpoints.VGN.size_bytes)
+    monkeypatch.setenv(checkpoints.CHECKPOINTS_ENV, str(tmp_path))
+    monkeypatch.setattr(checkpoints.os, "access", lambda p, mode: False)  # as a non-root user after chmod 0
+    assert checkpoints.missing_reason(checkpoints.VGN) == (
+        f"checkpoint {path} is unreadable (permission denied): make it readable (chmod a+r) or run "
+        "`python -m graspexp download_checkpoint vgn`"
+    )
+    monkeypatch.setenv(checkpoints.CHECKPOINTS_ENV, "/dev/zero")
+    assert checkpoints.missing_reason(checkpoints.VGN).startswith(
+        "checkpoint /dev/zero/vgn_conv.pth not found ($GRASPEXP_CHECKPOINTS names /dev/zero, which is not a folder)"
+    )
+
+
+def test_download_refuses_a_target_that_is_no_regular_file_without_reading_it(tmp_path, capsys):
+    """``download_checkpoint`` into a folder whose ``vgn_conv.pth`` is ``/dev/zero`` would hash it forever
+    (pooch checks a file already there): one line instead, and nothing contacted."""
+    (tmp_path / checkpoints.VGN.filename).symlink_to("/dev/zero")
+    argv = ["vgn", "--dir", str(tmp_path), "--url", "http://127.0.0.1:9/none", "--quiet"]
+    assert download_checkpoint.main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        f"graspexp download_checkpoint: error: {tmp_path / checkpoints.VGN.filename} is a character device, "
+        "not a regular file: remove it"
+    )

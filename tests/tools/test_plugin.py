@@ -156,7 +156,8 @@ def test_a_learned_plugin_joins_the_learned_pages_through_its_entry_point_alone(
     )
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert proc.stdout.splitlines() == [
-        "['fakenet, gripper=robotiq_2f85, camera views', 'vgn, gripper=panda, camera views']",
+        "['fakenet, gripper=robotiq_2f85, camera views', 'giga, gripper=panda, camera views', "
+        "'vgn, gripper=panda, camera views']",
         "['fakenet_robotiq_2f85', 'fakenet_robotiq_2f85', 'fakenet_rg2', 'clutter_camera_fakenet']",
         "['camera', 'learned', 'clutter_camera']",
         "['planner=fakenet', 'gripper=robotiq_2f85', 'dataset=ycb', 'mode=bin'] True",

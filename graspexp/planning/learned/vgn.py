@@ -15,6 +15,9 @@ depth views, with the network's own pre- and post-processing.
    target's candidates are those assigned to it; one is chosen. A clutter scene is planned through
    :func:`plan_vgn_scene` (the plugin's ``plan_scene``): one volume, one forward pass, every target.
 
+Another network on the same TSDF with the same detection (GIGA, :mod:`graspexp.planning.learned.giga`) plans
+through :func:`plan_in_volume` and :func:`plan_scene_in_volume` with its own forward pass (:data:`Outputs`).
+
 VGN's grasp frame (the authors' simulated Panda): +Z approach, +Y closing axis (the fingers at y = +-w/2),
 origin between the finger roots, the fingertips ``VGN_FINGER_DEPTH_M`` ahead along +Z; a grasp in voxel
 (i, j, k) lies at (i, j, k) x voxel length in the workspace frame; the quaternion is (x, y, z, w).
@@ -22,8 +25,10 @@ origin between the finger roots, the fingertips ``VGN_FINGER_DEPTH_M`` ahead alo
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import time
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,7 +37,7 @@ from scipy import ndimage
 from scipy.spatial.transform import Rotation
 
 from graspexp.config import GripperConfig
-from graspexp.config.planner.vgn import VgnConfig
+from graspexp.config.planner.vgn import VGN_CHECKPOINTS, VgnConfig
 from graspexp.grippers import GripperGeometry
 from graspexp.perception.tsdf import fuse
 from graspexp.planning.grasp import Grasp, NoFeasibleGrasp
@@ -55,9 +60,10 @@ INSIDE_MIN = 1e-3
 
 
 @functools.cache
-def network() -> VgnNet:
-    """The loaded network, read and verified once per process."""
-    return load_vgn()
+def network(checkpoint: str = "vgn_conv") -> VgnNet:
+    """The network with the weights ``checkpoint`` names (``planner.checkpoint``, :data:`VGN_CHECKPOINTS`),
+    read and verified once per process."""
+    return load_vgn(VGN_CHECKPOINTS[checkpoint])
 
 
 @dataclass(frozen=True)
@@ -74,23 +80,41 @@ class Detections:
     quality: np.ndarray
 
 
-def infer(net: VgnNet, grid: np.ndarray, threads: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """One forward pass on a (40, 40, 40) float32 TSDF: quality (40, 40, 40), quaternions (4, 40, 40, 40)
-    (x, y, z, w), widths (40, 40, 40) in voxels, float32."""
+@contextlib.contextmanager
+def torch_threads(threads: int) -> Iterator[None]:
+    """torch on ``threads`` threads in inference mode inside the block; the thread count restored after."""
     before = torch.get_num_threads()
     torch.set_num_threads(threads)
     try:
         with torch.inference_mode():
-            q, r, w = net(torch.from_numpy(np.ascontiguousarray(grid, np.float32))[None, None])
+            yield
     finally:
         torch.set_num_threads(before)
+
+
+def infer(net: VgnNet, grid: np.ndarray, threads: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One forward pass on a (40, 40, 40) float32 TSDF: quality (40, 40, 40), quaternions (4, 40, 40, 40)
+    (x, y, z, w), widths (40, 40, 40) in voxels, float32."""
+    with torch_threads(threads):
+        q, r, w = net(torch.from_numpy(np.ascontiguousarray(grid, np.float32))[None, None])
     return q[0, 0].numpy(), r[0].numpy(), w[0, 0].numpy()
+
+
+Outputs = Callable[[np.ndarray, VgnConfig], tuple[np.ndarray, np.ndarray, np.ndarray]]
+"""A network's forward pass on a (40, 40, 40) float32 TSDF with the planner's config: quality (40, 40, 40),
+quaternions (4, 40, 40, 40) (x, y, z, w), widths (40, 40, 40) in voxels (:func:`vgn_outputs`)."""
+
+
+def vgn_outputs(grid: np.ndarray, cfg: VgnConfig) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """VGN's forward pass with the weights of ``cfg.checkpoint`` on ``cfg.threads`` threads (:func:`infer`)."""
+    return infer(network(cfg.checkpoint), grid, cfg.threads)
 
 
 def detect(
     grid: np.ndarray, quality: np.ndarray, rot: np.ndarray, width_vox: np.ndarray, cfg: VgnConfig
 ) -> Detections:
-    """VGN's post-processing of one forward pass (voxel units inside, metres out)."""
+    """VGN's post-processing of one forward pass (voxel units inside, metres out), with GIGA's two additions
+    when set: the wall margin (``cfg.wall_margin_m``) and the forced best candidate (``cfg.force_threshold``)."""
     q = quality.astype(np.float64)
     if cfg.quality_sigma_voxels > 0:
         q = ndimage.gaussian_filter(q, sigma=cfg.quality_sigma_voxels, mode="nearest")
@@ -100,11 +124,20 @@ def detect(
         near = ndimage.binary_dilation(free, iterations=cfg.surface_band_voxels, mask=~behind)
     else:
         near = free
+    margin = int(cfg.wall_margin_m / VOXEL_M + 1e-9)  # GIGA's int(limit / voxel_size)
+    if margin > 0:
+        near[:margin], near[-margin:], near[:, :margin], near[:, -margin:] = False, False, False, False
     width_m = width_vox.astype(np.float64) * VOXEL_M
-    keep = near & (width_m >= cfg.min_width_m) & (width_m <= cfg.max_width_m) & (q >= cfg.quality_threshold)
+    valid = near & (width_m >= cfg.min_width_m) & (width_m <= cfg.max_width_m)
+    keep = valid & (q >= cfg.quality_threshold)
+    forced = cfg.force_threshold is not None and not keep.any()
+    if forced:
+        keep = valid & (q >= cfg.force_threshold)
     q = np.where(keep, q, 0.0)
     peak = ndimage.maximum_filter(q, size=cfg.nms_size_voxels)
     idx = np.argwhere(keep & (q == peak))  # C order: deterministic
+    if forced and len(idx):  # GIGA keeps the best of the suppressed candidates only
+        idx = idx[[int(np.argmax(q[tuple(idx.T)]))]]
     poses = np.tile(np.eye(4), (len(idx), 1, 1))
     if len(idx):
         quats = rot[:, idx[:, 0], idx[:, 1], idx[:, 2]].T.astype(np.float64)
@@ -182,16 +215,16 @@ class SceneGrasps:
     timing: dict[str, float]
 
 
-def scene_grasps(req: PlanRequest, volume: np.ndarray) -> SceneGrasps:
+def scene_grasps(req: PlanRequest, volume: np.ndarray, outputs: Outputs | None = None) -> SceneGrasps:
     """Fuse the request's depth views into the volume whose corner is ``volume`` (4, 4), run the network
-    once, detect (:func:`detect`) and assign every candidate to the object it holds (every object id > 0
-    of the observed cloud)."""
+    once (``outputs``, default VGN's: :func:`vgn_outputs`), detect (:func:`detect`) and assign every candidate
+    to the object it holds (every object id > 0 of the observed cloud)."""
     cfg: VgnConfig = req.planner
     obs = req.observation
     wall0, cpu0 = time.perf_counter(), time.process_time()
     grid = fuse(obs.views, volume, SIZE_M, GRID, DEPTH_MAX_M)
     wall1, cpu1 = time.perf_counter(), time.process_time()
-    quality, rot, width = infer(network(), grid, cfg.threads)
+    quality, rot, width = (outputs or vgn_outputs)(grid, cfg)
     wall2, cpu2 = time.perf_counter(), time.process_time()
     found = detect(grid, quality, rot, width, cfg)
     poses = volume @ found.poses @ graspexp_from_vgn(req.gripper)
@@ -228,8 +261,7 @@ def plan_vgn(req: PlanRequest) -> PlanResult:
     """The grasp VGN detects on the target in the request's camera observation, in a volume centred on the
     target's observed points; NoFeasibleGrasp (one line) when the request has no observation, the camera saw
     no target point, or no candidate holds it."""
-    target = _target_points(req)
-    return _choose(req, scene_grasps(req, world_from_volume(target, req.table_z)), paid=True)
+    return plan_in_volume(req, vgn_outputs)
 
 
 def plan_vgn_scene(req: SceneRequest) -> SceneResult:
@@ -237,6 +269,17 @@ def plan_vgn_scene(req: SceneRequest) -> SceneResult:
     scene (at the first target the camera saw), each candidate assigned to the object it holds; a target's
     candidates are those assigned to it. Targets in the request's order (``first_found``: up to the first
     grasp found); the fusion's and inference's times are in the extras of the target that paid them."""
+    return plan_scene_in_volume(req, vgn_outputs)
+
+
+def plan_in_volume(req: PlanRequest, outputs: Outputs) -> PlanResult:
+    """:func:`plan_vgn` with the forward pass ``outputs`` (a network of VGN's input and outputs)."""
+    target = _target_points(req)
+    return _choose(req, scene_grasps(req, world_from_volume(target, req.table_z), outputs), paid=True)
+
+
+def plan_scene_in_volume(req: SceneRequest, outputs: Outputs) -> SceneResult:
+    """:func:`plan_vgn_scene` with the forward pass ``outputs`` (a network of VGN's input and outputs)."""
     scene: SceneGrasps | None = None
 
     def plan_target(target: PlanRequest) -> PlanResult:
@@ -244,7 +287,8 @@ def plan_vgn_scene(req: SceneRequest) -> SceneResult:
         _target_points(target)
         paid = scene is None
         if scene is None:
-            scene = scene_grasps(target, world_from_scene_volume(target.workspace_xy, target.table_z))
+            volume = world_from_scene_volume(target.workspace_xy, target.table_z)
+            scene = scene_grasps(target, volume, outputs)
         return _choose(target, scene, paid)
 
     return per_object(plan_target)(req)
@@ -253,12 +297,14 @@ def plan_vgn_scene(req: SceneRequest) -> SceneResult:
 def _target_points(req: PlanRequest) -> np.ndarray:
     """(n, 3) the observed points of the request's target, world m; NoFeasibleGrasp without an observation
     or when the camera saw none."""
-    obs = req.observation
+    obs, name = req.observation, req.planner.name
     if obs is None:
-        raise NoFeasibleGrasp("vgn plans from the camera's depth views; the request carries no observation")
+        raise NoFeasibleGrasp(
+            f"{name} plans from the camera's depth views; the request carries no observation"
+        )
     target = np.asarray(obs.points)[np.asarray(obs.point_ids) == obs.target_id]
     if len(target) == 0:
-        raise NoFeasibleGrasp(f"vgn: the camera saw no point of the target (id {obs.target_id})")
+        raise NoFeasibleGrasp(f"{name}: the camera saw no point of the target (id {obs.target_id})")
     return target
 
 
@@ -271,7 +317,7 @@ def _choose(req: PlanRequest, scene: SceneGrasps, paid: bool) -> PlanResult:
     chosen = np.flatnonzero(scene.owner == obs.target_id)
     if len(chosen) == 0:
         raise NoFeasibleGrasp(
-            f"vgn: {len(found.quality)} detections above quality {cfg.quality_threshold}, none holds "
+            f"{cfg.name}: {len(found.quality)} detections above quality {cfg.quality_threshold}, none holds "
             f"{cfg.min_target_points} target points between its pads"
         )
     if cfg.selection == "best":

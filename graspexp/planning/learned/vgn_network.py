@@ -14,7 +14,7 @@ import torch
 from torch import nn
 from torch.nn import functional as F
 
-from graspexp.core.checkpoints import VGN, read_verified
+from graspexp.core.checkpoints import VGN, Checkpoint, read_verified
 
 GRID = 40
 """Voxels per side of the input grid (the network's strides and up-sampling sizes assume it)."""
@@ -73,11 +73,12 @@ class VgnNet(nn.Module):
         return quality, rotation, self.conv_width(x)
 
 
-def load_vgn() -> VgnNet:
-    """The network with the published weights, in eval mode on the CPU. The file's SHA-256 is checked on
+def load_vgn(ckpt: Checkpoint = VGN) -> VgnNet:
+    """The network with the published weights ``ckpt`` (VGN's ``vgn_conv.pth``, or a retraining with the same
+    tensors: ``vgn_pile``, ``vgn_packed``), in eval mode on the CPU. The file's SHA-256 is checked on
     the bytes that are loaded (:func:`graspexp.core.checkpoints.read_verified`); every tensor must match a
     parameter and every parameter must be in the file (``strict=True``)."""
-    state = torch.load(io.BytesIO(read_verified(VGN)), map_location="cpu", weights_only=True)
+    state = torch.load(io.BytesIO(read_verified(ckpt)), map_location="cpu", weights_only=True)
     net = VgnNet()
     net.load_state_dict(state, strict=True)
     return net.eval()

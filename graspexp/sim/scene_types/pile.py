@@ -13,6 +13,7 @@ from graspexp.core.bodies import TRAY_NAME, clutter_body
 from graspexp.core.geometry import make_pose, random_rotation
 from graspexp.core.phases import Phase
 from graspexp.datasets.model import ObjectModel
+from graspexp.sim.object_scale import scale_round_objects
 from graspexp.sim.round_scene import ClutterScene, RoundObject, add_clutter_object
 from graspexp.sim.round_sim import RoundSim, settle_all
 from graspexp.sim.scene import OBJECT_BIT, SUPPORT_BIT, set_groups
@@ -26,14 +27,16 @@ contact offset inside the wall)."""
 @register("pile")
 class Pile:
     """A heap: the box (``mode.tray_half_size_m``, ``mode.tray_wall_height_m``) is the scene's fixture; each
-    object is released at a random orientation over the box (:func:`pile_drop_pose`) and settled before the
-    next; the box is then taken away."""
+    object, scaled by ``mode.object_scale`` (:func:`graspexp.sim.object_scale.scale_round_objects`), is
+    released at a random orientation over the box (:func:`pile_drop_pose`) and settled before the next; the
+    box is then taken away."""
 
     def fixtures(self, ts: ClutterScene, cfg: JobConfig) -> None:
         ts.fixtures = _tray(ts.scene, cfg.mode, cfg)
 
     def place(self, sim: RoundSim, objects: Sequence[RoundObject], rng: np.random.Generator) -> None:
         ts, cfg = sim.ts, sim.cfg
+        scale_round_objects(objects, cfg.mode, rng)
         for slot, obj in enumerate(objects):
             top = max((ts.bodies[b][1].compute_global_aabb_tight()[1][2] for b in ts.bodies), default=0.0)
             pose = pile_drop_pose(obj.model, cfg.mode, float(top), rng)

@@ -1,0 +1,239 @@
+"""The test objects of the simulated clutter-removal benchmark of VGN (Breyer et al., CoRL 2020) and GIGA
+(Jiang et al., RSS 2021), reused by every later paper on that protocol (Edge-Grasp, ICGNet, NeuGraspNet,
+OrbitGrasp): ``pile/test`` (40 objects, ``dataset=vgn_pile``) and ``packed/test`` (16, ``dataset=vgn_packed``).
+
+Each object is a single-link URDF ``<name>.urdf`` (its ``<inertial>`` mass, no scale tag) with a collision
+mesh ``<name>_collision.obj`` (the authors' V-HACD convex decomposition: one ``o`` hull per part, 1 to 24
+parts) and a visual mesh ``<name>_visual.obj``, in metres. graspexp reads them as a ``folder`` layout reads a
+URDF (:mod:`graspexp.datasets.folder`): the object's mesh is the union of its collision hulls, its mass the
+URDF's. Sizes (collision meshes, sorted extents): pile median 4.4 x 7.0 x 8.7 cm (two axes normalised to the
+Panda's 8 cm stroke), packed median 7.1 x 7.3 x 14.7 cm. The protocol scales every placed object per scene
+(``mode.object_scale``).
+
+Where from (the pinned commit :data:`COMMIT` of the public repository ``supersglzc/GIGA``, MIT; the meshes
+come from YCB, BigBIRD, KIT and other object sets, whose own terms apply): ``data/urdfs/{pile,packed}/test``.
+:data:`MANIFEST` is the SHA-256 of all 168 files, the text of the manifest published beside the test copy of
+the data (its own SHA-256: :data:`MANIFEST_SHA256`); ``python -m graspexp download dataset=vgn_pile`` (or
+``vgn_packed``) fetches one set's files file by file and checks each against it
+(:func:`graspexp.datasets.download.download_vgn_clutter`).
+
+Layout under the data root: ``<root>/vgn_clutter/<scene>/test/<file>`` (the manifest's paths below
+``vgn_clutter/``).
+"""
+
+from __future__ import annotations
+
+import functools
+
+COMMIT = "30efe5946cb2622c21f140b3e811f7fcce804c7b"
+"""The commit of ``supersglzc/GIGA`` that added the test objects (unchanged at 7817add, its latest)."""
+URL = f"https://github.com/supersglzc/GIGA/raw/{COMMIT}/data/urdfs/"
+"""Base URL of the files: ``URL + "pile/test/<file>"``."""
+FOLDER = "vgn_clutter"
+"""The folder under the data root that holds ``pile/test`` and ``packed/test``."""
+SCENES = ("pile", "packed")
+"""The two object sets, by the scene type they are used in."""
+MANIFEST_SHA256 = "df5f971ee17972b4eb5faad3e52c0a7069dea8a8009fd70808b0c2e17e211692"
+"""SHA-256 of :data:`MANIFEST` (as published beside the data)."""
+MANIFEST = """\
+923411877d446b6959a815465ea0695522e26968a60b7ed3fd49a3d3f7bf411f  packed/test/3m_high_tack_spray_adhesive.urdf
+d17aa723db167d90c53a36d8f36f120d07a5d0abf783dc7b72efcc1eeceaeb43  packed/test/3m_high_tack_spray_adhesive_collision.obj
+c7c374e7d03b10b45aa9cad832292c4e7b34698c2f571ff5a3b9fa4f3451faee  packed/test/3m_high_tack_spray_adhesive_visual.obj
+3993e4fc0a6160e0fe784028c0623b032e2e6e5d5f335478c0cbfbbb7cb280d0  packed/test/BakingVanilla_800_tex.urdf
+4462d62443ef8fe2d252c710aa3e9cb6ddbcd4b979512ebd13462e46eec279f1  packed/test/BakingVanilla_800_tex_collision.obj
+0a519198a781abbbe989c9ae83aa8bd23e3c59ef395f9d87ca6cc5d470b53590  packed/test/BakingVanilla_800_tex_visual.obj
+37136a62158964bc6533545344e788941b71b9d39dbbfc4bedbe912eba713487  packed/test/CoffeeCookies_800_tex.urdf
+2ab191e6442462d62723d7fcc57e07eac40c95f097b94e8f37eabccbb6716e02  packed/test/CoffeeCookies_800_tex_collision.obj
+be71ab9036c23b0cca12fc5ad5cef0b28a9b01bb9c4461c52f90e17e36285f5c  packed/test/CoffeeCookies_800_tex_visual.obj
+09fcfce09cc55f8c2fbd62eb555f3a9d2155acd9f43dc183d380d5d8f6b6d49c  packed/test/FennelTea_800_tex.urdf
+e1ff22200591a2e9cb1e733b9d3b479367b4e5fe16a45bb73dedf0c9d90ebf70  packed/test/FennelTea_800_tex_collision.obj
+e6c5fa5c4dd66d74ad59c186db04e35472d073017f085ecbcb1b2069f75a73ca  packed/test/FennelTea_800_tex_visual.obj
+c34af5b98aa65298e2a9eda3194c4e0dc4740e989e9eaf3ecb71dfaa060b0f96  packed/test/FruitTea_800_tex.urdf
+3a3a4ed023d600d4b06f54c8020331e865b29f04b37247ec11753aac888d9865  packed/test/FruitTea_800_tex_collision.obj
+f0a637b1d4f7cac6a439daf702a8db35f3a5d7f12b1d69f423289824f97eef72  packed/test/FruitTea_800_tex_visual.obj
+23148a9248c91488e9443a317366196c46699b87d399f21a0ae4842097066ded  packed/test/KoalaCandy_800_tex.urdf
+138fcc0237c40285e4f6377f4cabbbfde814a2921345de4e454aa0ec5cfcd7c5  packed/test/KoalaCandy_800_tex_collision.obj
+827b9d5b2964a59bbc546239216fb40e3b986d63dd737fad2128207e47320327  packed/test/KoalaCandy_800_tex_visual.obj
+7ef66d69deee1a93d18ceae0c54bdfb908f6f37cee8238b9c48e67cf2f2e92db  packed/test/Paprika_800_tex.urdf
+e4fb92f1a1050da53bcb7e9b90d62c43e9144beba60e8e0de780a78445d59ed8  packed/test/Paprika_800_tex_collision.obj
+319e8de0a07b07bc12cb4d5dba18d4ce311b210a600cb9c2fa3599a2d638a960  packed/test/Paprika_800_tex_visual.obj
+d3f3c1864ed26aaa57e4536569e69801514007a0dabbdd4f64d898c877952d93  packed/test/PotatoeDumplings_800_tex.urdf
+80e4710c8b18c25e8d69611391e4725fae37762d0aa1345350923945c919daaa  packed/test/PotatoeDumplings_800_tex_collision.obj
+8da0eed9f5269f789618ed8e063d4ef08ef82a67419d3b498beb1703372c8c8a  packed/test/PotatoeDumplings_800_tex_visual.obj
+b9581f6b9d3ebf5520fdcb681ce28cb26db246962c7347c2a9659d7bbff445fe  packed/test/SoftCakeOrange_800_tex.urdf
+84bd0dc5d97855c38e14989b0c5b254cd40504f955d8af269fd024149bd72bc2  packed/test/SoftCakeOrange_800_tex_collision.obj
+f2b8251e0aac8010cbebc9cc1ca6a3059233361a88f845ba2b2bc5561426725c  packed/test/SoftCakeOrange_800_tex_visual.obj
+db0b5ee8803aac78929579c4afc8c7614e99d817d1bc245a40fa2d0624b9e899  packed/test/chips_can.urdf
+489f12e3f2bc9bad00779c96edc5e2662e532df8fc30f8572ed75e7222b1153c  packed/test/chips_can_collision.obj
+88e2bab26494a547a121edf4cf54bfe089bd0ce769247c4a52a09b3de1a133c2  packed/test/chips_can_visual.obj
+6a7630b1ae08d1dab467c493c06c9e7edaa234c4ee44c111a0370e783c10c5d4  packed/test/cracker_box.urdf
+771bce18c800db05266e1d2af41996ea848dabbdfbd775d1bfa675c6b29c1a2a  packed/test/cracker_box_collision.obj
+c124a65436d2bb99c535c92e6aa353ef7191d3e9d044206a25d5ce8aed4de2dc  packed/test/cracker_box_visual.obj
+908eaa03a75c2bf6b040cb869e504bb26042a9fc8b6e7dd77a87c2d12798b45e  packed/test/master_chef_can.urdf
+075f7427b97a0da9f27140812ba472614ebaa9866b8c68e22b06d9f75f5a7064  packed/test/master_chef_can_collision.obj
+bb0e3388199f372ee1b2baa1cb2c6f600e3fb43985444b08e39ecc54d8b07dfe  packed/test/master_chef_can_visual.obj
+934dfafe0ebbafe45957637675eecbcfa48271c33846b034d069a46bd5e85533  packed/test/pop_secret_butter.urdf
+7e2419f5bb556fd3d41d9d2d74afa60e4f87d55ad679ca4cd933db5fe99f9f8a  packed/test/pop_secret_butter_collision.obj
+24d16d425f88262dd853c247aef2bc4b2407884a489fd37b0862c8fd9a8dd193  packed/test/pop_secret_butter_visual.obj
+a19221e31f941c505bbae0cf66457c473f772dceb0fd86e9deab348574fc0285  packed/test/pudding_box.urdf
+61df80fcc11180fa13a0bcabd9bdf677afab0fa44ecfda330bbe5f2e83fc6fe5  packed/test/pudding_box_collision.obj
+e254597e90982afd790a7ede2f7c559893295b7297f24e863f13229d4041d64e  packed/test/pudding_box_visual.obj
+47ac157df614c7cbff63fb34ba2ebbf9475d9d7527cd88b1190dce71920bdad2  packed/test/south_beach_good_to_go_dark_chocolate.urdf
+c4dc885e32d72a33f818c60ba7395f25cd030bd974b8292e2bbf90cbc5fd1d80  packed/test/south_beach_good_to_go_dark_chocolate_collision.obj
+28734047942b1ba83907c6f842134957d4d91a7c69692e387a1100a8d4db5184  packed/test/south_beach_good_to_go_dark_chocolate_visual.obj
+104a3224460a8760d1ec24c6db5f8d45ff7e61861738936da385c6c3fa2fc7de  packed/test/wooden_block.urdf
+a232be651a40953b0ba2d7cfca8d509c766fd7e62b2c63ef6a3aa531a505bd57  packed/test/wooden_block_collision.obj
+8f053e2490fb9e8c50ea671b05641669223dd7abff6bf5a1e382e3f82646a139  packed/test/wooden_block_visual.obj
+923411877d446b6959a815465ea0695522e26968a60b7ed3fd49a3d3f7bf411f  pile/test/3m_high_tack_spray_adhesive.urdf
+bf072ae1d7d90f8d8f6ea40896826a7c4e5347fd6f8155ccf087aebf00c655a0  pile/test/3m_high_tack_spray_adhesive_collision.obj
+72c3dad67272eb6da12bf8a4702ab565db054b7a9ffc7a3599160c0b655efd2a  pile/test/3m_high_tack_spray_adhesive_visual.obj
+3993e4fc0a6160e0fe784028c0623b032e2e6e5d5f335478c0cbfbbb7cb280d0  pile/test/BakingVanilla_800_tex.urdf
+8274b22346e285c82c8d3d3aaee7cc1df34f4726c4f668acb71419d391acbdad  pile/test/BakingVanilla_800_tex_collision.obj
+18be0c0969087ae9efaed5625391863690a4f9a928041d9c26d13462a0a01fb4  pile/test/BakingVanilla_800_tex_visual.obj
+b0db03390840ad31ea1c6ff9b72df2d348497e46b3796f6a53efa34f774731d8  pile/test/ChocSticks2_800_tex.urdf
+dba23c2699eb107c0ea67c87fe61b888f9f15ec8e1836f73459c6ad7f082de8b  pile/test/ChocSticks2_800_tex_collision.obj
+6105a34851b29268eafe9467e98ee00dc949c3364e951e83bea1eb1ef7a74ddf  pile/test/ChocSticks2_800_tex_visual.obj
+4ff92d7b20e8e6b981ef2e4e934de86d0d9d0199a42d86afdad98121f9d27084  pile/test/ChocSticks_800_tex.urdf
+0154c9a77a355d7fef2a148c1179afba87abed536e347ce3594d149492ced0e5  pile/test/ChocSticks_800_tex_collision.obj
+6a652edddf3582d41c74680c2f5d6d8676d04f2df9718e4025f44165c2622073  pile/test/ChocSticks_800_tex_visual.obj
+37136a62158964bc6533545344e788941b71b9d39dbbfc4bedbe912eba713487  pile/test/CoffeeCookies_800_tex.urdf
+0a3e78ef6543aeb29ad5f55164d2479297a12ea21242697b9c4592dc0e7d522f  pile/test/CoffeeCookies_800_tex_collision.obj
+400da1ef96638dcb7406afc94aa822b456f9c63cc0c52a031c3a67bdb494c3be  pile/test/CoffeeCookies_800_tex_visual.obj
+09fcfce09cc55f8c2fbd62eb555f3a9d2155acd9f43dc183d380d5d8f6b6d49c  pile/test/FennelTea_800_tex.urdf
+3715cef68ec1a59d0026050896619b005cb0c52a232984730c468c38afad192e  pile/test/FennelTea_800_tex_collision.obj
+f49e5005b9c55a18611c328e6e8317b733c2e737da769fb094739d66f21abe87  pile/test/FennelTea_800_tex_visual.obj
+c34af5b98aa65298e2a9eda3194c4e0dc4740e989e9eaf3ecb71dfaa060b0f96  pile/test/FruitTea_800_tex.urdf
+ecb640423dd0c61c8fbd5b4a5bc2b6379cbc730501280f6509fd9fb953803668  pile/test/FruitTea_800_tex_collision.obj
+6fd656fc8c33fa13eead137b79c7049692478ae0a6fb500c8d791f6f266337b2  pile/test/FruitTea_800_tex_visual.obj
+23148a9248c91488e9443a317366196c46699b87d399f21a0ae4842097066ded  pile/test/KoalaCandy_800_tex.urdf
+8eaf492f4a64b706b43bee5d503ee425d14f548b7479470670d492a6df5adfaa  pile/test/KoalaCandy_800_tex_collision.obj
+82c3ebafa4d76668bf8c4d9de6e357cabe1e6234b3200f451b89e16596442570  pile/test/KoalaCandy_800_tex_visual.obj
+a873a1a53da7826e8770301f9b113c673149d55a9d037d0a1a727172e3e63892  pile/test/NutCandy_800_tex.urdf
+5c98ed6e415b039610c94b5f6b7ebe93e184909722d71e12541ed4622f2c09e8  pile/test/NutCandy_800_tex_collision.obj
+38b0ac7a4509b42c6b2b0b4511f63c71a9517bbfd98547addd38f908078fbf49  pile/test/NutCandy_800_tex_visual.obj
+7ef66d69deee1a93d18ceae0c54bdfb908f6f37cee8238b9c48e67cf2f2e92db  pile/test/Paprika_800_tex.urdf
+febb77b2043d6b9e899d8b685b4dc8077a2019f23ab705e5447834894b6f5bed  pile/test/Paprika_800_tex_collision.obj
+e4acf7f6d35f4e77168f96df9e2fdcd626c6c6b99ebee46c8f3f13a43c8eeec1  pile/test/Paprika_800_tex_visual.obj
+d3f3c1864ed26aaa57e4536569e69801514007a0dabbdd4f64d898c877952d93  pile/test/PotatoeDumplings_800_tex.urdf
+c52fa02ba80832ef987d4543165e69584ce4fc196542bb912b3f263a4bb2c6a5  pile/test/PotatoeDumplings_800_tex_collision.obj
+6081b4a7b740a2ecb7a49bc9b436902c3f003c08f48a4655bed54118bfbbeb41  pile/test/PotatoeDumplings_800_tex_visual.obj
+b9581f6b9d3ebf5520fdcb681ce28cb26db246962c7347c2a9659d7bbff445fe  pile/test/SoftCakeOrange_800_tex.urdf
+585ebf61d82fc6da40744142b48c706657838ff69c57fd69046977f05b0eda64  pile/test/SoftCakeOrange_800_tex_collision.obj
+faf43366aca02b7d7d13d4d0acb4bf4e5eb5bde5b9da1da6ad3f817e7f060e8f  pile/test/SoftCakeOrange_800_tex_visual.obj
+e7a36b0a053c036529371c2de8f1e0d06114d10d17dd127a58df1076e9ce70b5  pile/test/bea77759a3e5f9037ae0031c221d81a4.urdf
+84b969dfdc604636d60d20d97acead798a929fa1b74c17c1d05a61b2ff973345  pile/test/bea77759a3e5f9037ae0031c221d81a4_collision.obj
+3a979b7fbd92304595f21aa42386a88bc5b22ce702dff4c355e9c0353ed95815  pile/test/bea77759a3e5f9037ae0031c221d81a4_visual.obj
+40cb64ad4348f8ab115f08bd95c1e98b116f8943ab2430fed0fb8bd4e4aad9db  pile/test/blackshoes.urdf
+bfd7ecc0e0b0c6ec042ddde37e23046c6a155f1f8b6cebcfbe8ab6347b5d9309  pile/test/blackshoes_collision.obj
+8e096138623871b738a9915411634706da3dc77ae772542612fcf4d613624a3c  pile/test/blackshoes_visual.obj
+4b890c5504b0116a252f04c6408a54d8cf1bb0e96e531476cb742d8f0493f1da  pile/test/boot_poisson_005.urdf
+a50bbf0bbf9f98a57e30269bf9f33be77e5b185cec4d9aab57509882499f3155  pile/test/boot_poisson_005_collision.obj
+f0ed795db0fc58f95b6bc248082e5010795b0f63f84dd02f17141d25e33c6f5f  pile/test/boot_poisson_005_visual.obj
+16cfaf51c3283da4bf1ca380543e2f6e859943802e0077ca5e316cdaa27a848c  pile/test/bottle_new_poisson_000.urdf
+f2640094bd5dd1cb85cef72f16ecd844c14679378e79f2247754d85b9ee71504  pile/test/bottle_new_poisson_000_collision.obj
+ec8502d884e5736a929173b8195d17e2ec3b6603e9011632638eece4929e5cdf  pile/test/bottle_new_poisson_000_visual.obj
+55e9e707b337034511dfd2d00cf65ab38f7c149e7e17b209f73569203f445498  pile/test/bowl.urdf
+d1249221926ee94a7736cd2aaab1587f99f44bcc5157204e007b52ca4131a516  pile/test/bowl_collision.obj
+8b76725df51920493db23d8eda51d6c3560c45f0993b0dd705747a284222e71a  pile/test/bowl_visual.obj
+7b13e305400976057b02f4a66100b159b6bdd1b113c682b1c9bb86cfe2c694ed  pile/test/bowling_pin_poisson_000.urdf
+5b13785aadd3bf426762fa99cd7e675518456b309d490250b492473e8a15feb3  pile/test/bowling_pin_poisson_000_collision.obj
+75d6f4f59a5bf8cda2d1c9f5b384d7a18d86d98bfecd55c59996afc0ac515719  pile/test/bowling_pin_poisson_000_visual.obj
+90044e7f082f1efd73a306a490cc1ab98811484c7e07e1212aad945ed10ce6dc  pile/test/bumblebee_albacore.urdf
+78fc5abf71642b10aff35a20beb5ac566df4b9716d64d119b06dd84ef1b54f25  pile/test/bumblebee_albacore_collision.obj
+2a53adf211dd0c80156149222ca84661ee7ae667ef63c9752ea7c1ee05df1884  pile/test/bumblebee_albacore_visual.obj
+db0b5ee8803aac78929579c4afc8c7614e99d817d1bc245a40fa2d0624b9e899  pile/test/chips_can.urdf
+0f052cd0043975628546daebf8c6db3c149e15a71d7102073b6ebc989d2c9c63  pile/test/chips_can_collision.obj
+9a4e32c21772aa21cc940343170506262aadbed8f3d598d5eadebb302cd7f2f2  pile/test/chips_can_visual.obj
+6a7630b1ae08d1dab467c493c06c9e7edaa234c4ee44c111a0370e783c10c5d4  pile/test/cracker_box.urdf
+28aa74ad12bfd32a4e872d35d42910fad7ee3e8782c7775ca123a84338b3cd3d  pile/test/cracker_box_collision.obj
+db08d69aa7dba98f93c2df7320716696d7c5b3606c23d4f9ecb9f921f5ceaf50  pile/test/cracker_box_visual.obj
+678930fdd156a138e7936e0d6b109ec2ee23acf132c1dbb62cb7fdf4532684d9  pile/test/donut_poisson_000.urdf
+57e8997af7097992a82355bd036e813aca880a73079981cd14a2fc4e5d21bc10  pile/test/donut_poisson_000_collision.obj
+4aec59dc85a12690f49949abbc8ccfd56fd90a5a33935c4d41f2928819dac043  pile/test/donut_poisson_000_visual.obj
+4be5f94307ebb26f1e5d0eaedfc7aaa6bb1c1ef421b7c9ff856dc3bd3bab85b9  pile/test/donut_poisson_006.urdf
+b7d51d6694fe2a57f1947bac1736d03f72522cea7f82537b99830cc03b7371f6  pile/test/donut_poisson_006_collision.obj
+ea8ccc5e951cc9d360cf84fa65c45fe42bf85d1d886bba5dbad5b73c29878341  pile/test/donut_poisson_006_visual.obj
+3139b0964be6f1a2b2701cdc7707c00476a0a366f6ed9a00e2f473a406a894dc  pile/test/hammer_poisson_008.urdf
+256b97ac651a26a26065bffae803e6373d0734cdb744386570d3558757a3cc8b  pile/test/hammer_poisson_008_collision.obj
+1994d0f0558440eabbbdb03b942d242e19bfea03a44311e16fe07db3495848e9  pile/test/hammer_poisson_008_visual.obj
+5ca4f199d5a61bb7a1b0eb27d9f577f79bea9683b316114a113ee0b6ab168072  pile/test/hammer_poisson_009.urdf
+67122fe4b18741adc2cd7fdbb13acefd716db0fc37b16640e8f072aea88029ea  pile/test/hammer_poisson_009_collision.obj
+a5b56127f4ea80d2174687e758879497085a2823cf4adb6a5b3a74ee58b0d3e3  pile/test/hammer_poisson_009_visual.obj
+b92e18a8fdf424bcafd053dab5ff019e42b7a0f0ce0e5a01a2c55c797aeaf6f0  pile/test/hammer_poisson_012.urdf
+40e7fa826ec0ee4969facfbed6182a834519cfae878b82cf5592d387bce772c1  pile/test/hammer_poisson_012_collision.obj
+baf02535a5a2960b721b75ef94446ba785b50efcc7add2028e1e57ea14639f78  pile/test/hammer_poisson_012_visual.obj
+8d7415561a65a8f960e3d0ff1da7317d8beb5bf610f5e281b1344044f9bb7987  pile/test/jar_poisson_004.urdf
+d057125dbc0cae3a57ee90d1cbc08f7b71ebd200b1faa431f0c5a791df7054b5  pile/test/jar_poisson_004_collision.obj
+2fee1bb574e43d638a4a125873b708d54ad2e7b7a32a79746301e63f97af2e9d  pile/test/jar_poisson_004_visual.obj
+49da02a270053383020e242a9c3ab7fc0c1c904949057e3e5a599acaa196d807  pile/test/lemon_poisson_000.urdf
+9e470fef2de8d68f9677a46d8a652c23e707fc24e25a99a5cffe3df60715b239  pile/test/lemon_poisson_000_collision.obj
+16a84c064a90f23c8f0f6dba0f89501b00594bcb0e18928d4c10ec847cd1317d  pile/test/lemon_poisson_000_visual.obj
+ecaf5c31ce3e875965841154b5f4058745025e721656e5da2b2e226ef76ad385  pile/test/light_bulb_poisson_001.urdf
+e9f8d9df0e71397f1b1a974967660a2bdfe8e5473dfc84a0c53baa567655cf49  pile/test/light_bulb_poisson_001_collision.obj
+d630e10739813db39ce20fc53a9fb72ebbb8ec1e41f29e5e9b76600608f1c5cd  pile/test/light_bulb_poisson_001_visual.obj
+908eaa03a75c2bf6b040cb869e504bb26042a9fc8b6e7dd77a87c2d12798b45e  pile/test/master_chef_can.urdf
+7dad79f9c1cb520ec242f1c8b28de261e4cfcb7019cbf98decc9d76921616be8  pile/test/master_chef_can_collision.obj
+0e898c5a982d91a95ac3c6ced584feba4e28f24670565d4265ed84927965c4a2  pile/test/master_chef_can_visual.obj
+8dc8bd671b07a48f959fb5cd65611ceb53286b0b88fd62f5a1d48bff55a97a32  pile/test/mushroom_poisson_005.urdf
+62bbb793d46c576e1e287399192eeec19a377f9d92cc3abcf4a560d5ae634f90  pile/test/mushroom_poisson_005_collision.obj
+f3e34bc8fb8ddca363c13e6303c76cc1fed7fc64b8a670a5d4d804fc046143b4  pile/test/mushroom_poisson_005_visual.obj
+3835be3232846541c49745fc68344d01aeff7015880484fe08311e10438006e6  pile/test/pliers_poisson_014.urdf
+c6622aef93997730536e3f0f6a4fd7d2264921c0020cfb1e85474d7ad312d70d  pile/test/pliers_poisson_014_collision.obj
+e7d584752c4d7a9e667b7a0f2bf24b59c1edf67899966f5e6436ff406d19917c  pile/test/pliers_poisson_014_visual.obj
+934dfafe0ebbafe45957637675eecbcfa48271c33846b034d069a46bd5e85533  pile/test/pop_secret_butter.urdf
+f9cad5069517b868c0847ff3e7c2a6113347fe90be472dcbbd631a1c18f34a86  pile/test/pop_secret_butter_collision.obj
+b40d917d649f2e1a175f9f3aa0438bba9663f1690c05babab343d37f7125cf0a  pile/test/pop_secret_butter_visual.obj
+a19221e31f941c505bbae0cf66457c473f772dceb0fd86e9deab348574fc0285  pile/test/pudding_box.urdf
+20e15cda9628c379e68d01e41507574d44d1d7a497b2b9c894b75253f38e7762  pile/test/pudding_box_collision.obj
+63ebf3b9afb3fbb79bd1155eafc4d9fa98cdf94976a59600929542a567f3bbaf  pile/test/pudding_box_visual.obj
+1209d2bdbb54d6ce69e7eb4918ad1b0fc6fe2230ae6122b0e887d7ca87722ca6  pile/test/quaker_big_chewy_chocolate_chip.urdf
+f9ea62578f249aa4cad7fb7646e86852e414358554e6e780573c3264cab2fda9  pile/test/quaker_big_chewy_chocolate_chip_collision.obj
+cf2be214a06e2eab16e046054e283c1f82159728582ec2482f335ef38365cf17  pile/test/quaker_big_chewy_chocolate_chip_visual.obj
+d132a2cb4a33e4ed3fac616b8bbd8f8995198f1eb579c56b1e8b03a125581586  pile/test/rubik_cube_poisson_004.urdf
+fd6cb632a93c184c2e3a22a1ae4b19dfa0d49093e58ad7388b42b1ca031905b2  pile/test/rubik_cube_poisson_004_collision.obj
+0591cf21affa428f814760f01702b3ed4b3b6b92fd29b779478f6ea2d22123bf  pile/test/rubik_cube_poisson_004_visual.obj
+3fe2c86bf2fcfe7fb3cecc2e8454b8c7e6768e41729239c7d350abb2951622c4  pile/test/soccer_ball_poisson_000.urdf
+b95b3aef36dfc7c89d59e025043b6de1e472123c70d52612756b8fb3a4623043  pile/test/soccer_ball_poisson_000_collision.obj
+7638514b99770d503332e7ec228c4f1d19e644e435e0cc9cb754479df94a3348  pile/test/soccer_ball_poisson_000_visual.obj
+47ac157df614c7cbff63fb34ba2ebbf9475d9d7527cd88b1190dce71920bdad2  pile/test/south_beach_good_to_go_dark_chocolate.urdf
+d7e81600b26fd369964f6154be39b70b00c7ebcfb788fd664c081cbdec0d9939  pile/test/south_beach_good_to_go_dark_chocolate_collision.obj
+8ae78396e506c601fdac77d1136744974eb43d30e8d23ded9cf8d28b860882c0  pile/test/south_beach_good_to_go_dark_chocolate_visual.obj
+173556c5bca53ccd6ce4ab40e57e90557b619c77fb79d26760fc4381d83a0572  pile/test/spray_can_poisson_001.urdf
+28995d9669c52633b1ddbf95ca384454b864149f06abc49eaff26f58e129bcc1  pile/test/spray_can_poisson_001_collision.obj
+ee40b7f79b2411d7ecd3209ba170ad4d729108c754859ebe0c34721d63933101  pile/test/spray_can_poisson_001_visual.obj
+104a3224460a8760d1ec24c6db5f8d45ff7e61861738936da385c6c3fa2fc7de  pile/test/wooden_block.urdf
+78204496e2e04d978b6784666ad8e4c43d1a8aeb0fb197028f869adbcefb8913  pile/test/wooden_block_collision.obj
+894c44f381ff405000d8678d15c441717816f9307d6961ef308397c3b9086b38  pile/test/wooden_block_visual.obj
+"""
+"""``sha256sum`` lines ``<hex>  <scene>/test/<file>`` of every file of both sets."""
+
+
+@functools.cache
+def manifest_files() -> dict[str, str]:
+    """``<scene>/test/<file>`` -> hex SHA-256 of every file of :data:`MANIFEST`."""
+    out = {}
+    for line in MANIFEST.splitlines():
+        digest, path = line.split(maxsplit=1)
+        out[path] = digest
+    return out
+
+
+def set_folder(scene: str) -> str:
+    """The folder of the set of ``scene`` below the data root: ``vgn_clutter/<scene>/test``."""
+    return f"{FOLDER}/{scene}/test"
+
+
+def scene_files(scene: str) -> dict[str, str]:
+    """File name -> hex SHA-256 of every file of the set of ``scene`` (``pile`` or ``packed``)."""
+    prefix = f"{scene}/test/"
+    return {p.removeprefix(prefix): d for p, d in manifest_files().items() if p.startswith(prefix)}
+
+
+def object_names(scene: str) -> tuple[str, ...]:
+    """The objects of the set of ``scene``: the stems of its URDFs, sorted."""
+    return tuple(sorted(f.removesuffix(".urdf") for f in scene_files(scene) if f.endswith(".urdf")))
+
+
+def object_files(name: str) -> tuple[str, ...]:
+    """The files of object ``name`` (of either set): its URDF and the two meshes it names."""
+    return (f"{name}.urdf", f"{name}_collision.obj", f"{name}_visual.obj")
