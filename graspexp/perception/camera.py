@@ -22,7 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 
-from graspexp.config.perception import CAMERA_EXTRA, CameraConfig
+from graspexp.config.perception import CameraConfig
+from graspexp.perception.imports import import_optional
 
 
 @dataclass(frozen=True)
@@ -108,10 +109,7 @@ def _ray_lengths(w: int, h: int, fx: float, fy: float, cx: float, cy: float) -> 
 
 
 def _require_embree() -> None:
-    try:
-        import embreex  # noqa: F401
-    except ImportError:
-        raise ImportError(f"the depth camera needs embreex, not installed: {CAMERA_EXTRA}") from None
+    import_optional("embreex", "embreex", "the depth camera")
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from graspexp.config.perception import CAMERA_EXTRA, RegistrationConfig
+from graspexp.config.perception import RegistrationConfig
+from graspexp.perception.imports import import_optional
 
 
 @dataclass(frozen=True)
@@ -53,12 +54,9 @@ class Registration:
 
 @functools.cache
 def open3d():
-    """The ``open3d`` module, its parallel loops limited to one thread (module doc); ImportError naming the
-    install command when it is absent."""
-    try:
-        import open3d as o3d
-    except ImportError:
-        raise ImportError(f"pose registration needs open3d-cpu, not installed: {CAMERA_EXTRA}") from None
+    """The ``open3d`` module, its parallel loops limited to one thread (module doc); ImportError naming what
+    is wrong when it cannot be imported (:func:`graspexp.perception.imports.import_optional`)."""
+    o3d = import_optional("open3d", "open3d-cpu", "pose registration")
     o3d.utility.set_max_threads(1)
     return o3d
 
