@@ -2,21 +2,25 @@
 install command), or installed but unable to load (the missing system library and the package providing it)."""
 
 import importlib
+from types import SimpleNamespace
 
 import pytest
 
 from graspexp.config.perception import CAMERA_EXTRA
-from graspexp.perception import registration
+from graspexp.perception import imports, registration
 from graspexp.perception.imports import import_optional
 
 
 def _failing(monkeypatch, module: str, exc: ImportError) -> None:
+    """Importing ``module`` through :mod:`graspexp.perception.imports` raises ``exc`` (nothing else changes)."""
     real = importlib.import_module
-    monkeypatch.setattr(
-        importlib,
-        "import_module",
-        lambda name, *a: (_ for _ in ()).throw(exc) if name == module else real(name, *a),
-    )
+
+    def fake(name: str, *args):
+        if name == module:
+            raise exc
+        return real(name, *args)
+
+    monkeypatch.setattr(imports, "importlib", SimpleNamespace(import_module=fake))
 
 
 def test_an_installed_library_that_cannot_load_names_the_missing_system_library(monkeypatch):
