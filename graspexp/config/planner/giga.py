@@ -15,13 +15,12 @@ missing, as one line naming the command, when a config selects the planner.
 """
 
 from dataclasses import dataclass
-from importlib.util import find_spec
 
 from graspexp.config.constraints import Interval, Options
 from graspexp.config.planner.vgn import CONSTRAINTS as VGN_CONSTRAINTS
-from graspexp.config.planner.vgn import EXTRA_MODULES, INSTALL, VgnConfig
+from graspexp.config.planner.vgn import VgnConfig, learned_unavailable
 from graspexp.config.plugins import Learned, PlannerPlugin
-from graspexp.core.checkpoints import GIGA_LICENCE, GIGA_MODELS_URL, Checkpoint, missing_reason
+from graspexp.core.checkpoints import GIGA_LICENCE, GIGA_MODELS_URL, Checkpoint
 
 
 def _giga(scene: str, sha256: str) -> Checkpoint:
@@ -75,15 +74,8 @@ CONSTRAINTS = {
 
 
 def unavailable() -> str:
-    """'' when ``planner=giga`` can run here, else one line naming what is missing and the command that
-    brings it (the optional extra, then the default checkpoint). This check does not see the config: with
-    another ``planner.checkpoint`` whose file is missing, each trial ends in an error of one line naming the
-    download command (:class:`graspexp.core.checkpoints.CheckpointError`; the trial is listed as not run).
-    Nothing is imported."""
-    absent = [m for m in EXTRA_MODULES if find_spec(m) is None]
-    if absent:
-        return f"it needs {' and '.join(absent)}, the optional extra 'learned': {INSTALL}"
-    return missing_reason(GIGA_CHECKPOINTS[GigaConfig.checkpoint])
+    """:func:`graspexp.config.planner.vgn.learned_unavailable` of ``planner=giga``'s default checkpoint."""
+    return learned_unavailable(GIGA_CHECKPOINTS[GigaConfig.checkpoint])
 
 
 PLUGIN = PlannerPlugin(

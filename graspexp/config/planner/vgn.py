@@ -100,16 +100,21 @@ CONSTRAINTS = {
 """Allowed values of every key of :class:`VgnConfig` (see :mod:`graspexp.config.constraints`)."""
 
 
-def unavailable() -> str:
-    """'' when ``planner=vgn`` can run here, else one line naming what is missing and the command that
-    brings it (the optional extra, then the default checkpoint). This check does not see the config: with
-    another ``planner.checkpoint`` whose file is missing, each trial ends in an error of one line naming the
-    download command (:class:`graspexp.core.checkpoints.CheckpointError`; the trial is listed as not run).
-    Nothing is imported."""
+def learned_unavailable(checkpoint: Checkpoint) -> str:
+    """'' when a learned planner of the optional extra ``learned`` can run here with ``checkpoint``, else one line
+    naming what is missing and the command that brings it (the extra's modules, then the checkpoint). It does
+    not see the config: with another ``planner.checkpoint`` whose file is missing, each trial ends in an error
+    of one line naming the download command (:class:`graspexp.core.checkpoints.CheckpointError`; the trial is
+    listed as not run). Nothing is imported."""
     absent = [m for m in EXTRA_MODULES if find_spec(m) is None]
     if absent:
         return f"it needs {' and '.join(absent)}, the optional extra 'learned': {INSTALL}"
-    return missing_reason(VGN)
+    return missing_reason(checkpoint)
+
+
+def unavailable() -> str:
+    """:func:`learned_unavailable` of ``planner=vgn``'s default checkpoint."""
+    return learned_unavailable(VGN)
 
 
 PLUGIN = PlannerPlugin(
