@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import pytest
 
 from graspexp.config.perception import CAMERA_EXTRA
-from graspexp.perception import imports, registration
+from graspexp.perception import registration
 from graspexp.perception.imports import import_optional
 
 
@@ -20,7 +20,10 @@ def _failing(monkeypatch, module: str, exc: ImportError) -> None:
             raise exc
         return real(name, *args)
 
-    monkeypatch.setattr(imports, "importlib", SimpleNamespace(import_module=fake))
+    registration.open3d.cache_clear()  # it keeps the module once loaded
+    # the modules the functions were defined in (another test may have re-imported the package)
+    for fn in (import_optional, registration.import_optional):
+        monkeypatch.setitem(fn.__globals__, "importlib", SimpleNamespace(import_module=fake))
 
 
 def test_an_installed_library_that_cannot_load_names_the_missing_system_library(monkeypatch):

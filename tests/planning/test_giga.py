@@ -30,6 +30,7 @@ from omegaconf import OmegaConf  # noqa: E402
 
 from graspexp.config import ConfigError  # noqa: E402
 from graspexp.config.planner import giga as giga_schema  # noqa: E402
+from graspexp.config.planner import vgn as vgn_schema  # noqa: E402
 from graspexp.config.plugins import planner_names  # noqa: E402
 from graspexp.config.validate import validate  # noqa: E402
 from graspexp.core import checkpoints  # noqa: E402
@@ -140,7 +141,7 @@ def test_a_missing_giga_checkpoint_or_extra_stops_the_config_with_one_line(regis
         validate(compose_cfg("planner=giga"))
     assert str(err.value).startswith("planner=giga cannot run here: checkpoint ")
     assert "python -m graspexp download_checkpoint giga_pile" in str(err.value) and "\n" not in str(err.value)
-    monkeypatch.setattr(giga_schema, "find_spec", lambda name: None if name == "torch" else object())
+    monkeypatch.setattr(vgn_schema, "find_spec", lambda name: None if name == "torch" else object())
     with pytest.raises(
         ConfigError, match=r"needs torch, the optional extra 'learned': pip install -e '\.\[learned\]'$"
     ):
